@@ -1,0 +1,52 @@
+// Piecewise-constant 1D and 2D distributions (pbrt's PiecewiseConstant1D/2D), used for
+// light selection by power, triangle selection by area and environment importance sampling.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "core/vec.h"
+
+namespace caustica {
+
+class Distribution1D {
+ public:
+  Distribution1D() = default;
+  // Negative and non-finite weights are treated as 0. An all-zero input becomes uniform.
+  explicit Distribution1D(std::vector<float> weights);
+
+  size_t size() const { return func_.size(); }
+  float integral() const { return integral_; }
+  // Sum of the input weights (the integral over [0, size)).
+  float total() const { return integral_ * float(func_.size()); }
+
+  // Discrete: picks index i with probability weight_i / total. *remapped gets u rescaled to
+  // [0,1) within the chosen bucket, so one number can drive two decisions.
+  size_t sample_discrete(float u, float* pmf, float* remapped = nullptr) const;
+  float pmf(size_t i) const;
+  // Continuous on [0,1): density pdf(x) = func(x) / integral.
+  float sample_continuous(float u, float* pdf, size_t* offset = nullptr) const;
+  float pdf_continuous(float x) const;
+
+ private:
+  std::vector<float> func_, cdf_;
+  float integral_ = 0;
+};
+
+class Distribution2D {
+ public:
+  Distribution2D() = default;
+  // values[v * width + u]; density over [0,1)^2 proportional to the values.
+  Distribution2D(const std::vector<float>& values, int width, int height);
+  Vec2 sample(Vec2 u, float* pdf) const;
+  float pdf(Vec2 p) const;
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+ private:
+  int width_ = 0, height_ = 0;
+  std::vector<Distribution1D> conditional_;
+  Distribution1D marginal_;
+};
+
+}  // namespace caustica

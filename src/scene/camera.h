@@ -1,0 +1,75 @@
+// Perspective camera with pbrt-v4's semantics: camera space is left-handed (+z forward,
+// +y up, +x toward raster +x), `fov` spans the shorter image axis, raster y grows downward.
+// A lens radius > 0 makes it a thin-lens camera focused at `focal_distance`.
+//
+// Importance (for light tracing, pbrt-v4 PerspectiveCamera::We): We is normalised over the
+// whole image, We = 1 / (A * lens_area * cos^4 theta), with A the image-plane area at
+// distance 1 and lens_area = 1 for a pinhole. With the box pixel filter, the importance of
+// one pixel is pixel_count() * We.
+#pragma once
+
+#include <optional>
+
+#include "core/transform.h"
+#include "core/vec.h"
+
+namespace caustica {
+
+struct CameraParams {
+  Transform camera_to_world;
+  int width = 512, height = 512;
+  float fov_degrees = 90;
+  float lens_radius = 0;
+  float focal_distance = 1e6f;
+  // Optional pbrt "screenwindow" [xmin xmax ymin ymax]; empty = derived from aspect ratio.
+  float screen_window[4] = {0, 0, 0, 0};
+};
+
+struct CameraWiSample {
+  float importance = 0;   // We along the ray from the lens point to ref
+  Vec3 wi;                // unit, from ref toward the lens point
+  float distance = 0;
+  Vec3 p_lens;            // the point on the lens (world)
+  float pdf_w = 0;        // solid-angle density at ref of choosing this lens point
+  Vec2 raster;            // where the ray lands on the film
+  float cos_at_camera = 0;  // cos between the camera axis and the direction to ref
+};
+
+class Camera {
+ public:
+  Camera() = default;
+  explicit Camera(const CameraParams& params);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  size_t pixel_count() const { return size_t(width_) * size_t(height_); }
+  Vec3 position() const { return origin_; }
+  Vec3 forward() const { return forward_; }
+  bool is_pinhole() const { return lens_radius_ == 0; }
+  float lens_area() const;
+  float image_plane_area() const { return image_plane_area_; }
+
+  // Ray through continuous raster position (x right, y down, in pixels) and lens sample.
+  Ray generate_ray(Vec2 raster, Vec2 u_lens) const;
+
+  // Raster position of the camera ray with direction dir leaving p_lens; nothing if it
+  // misses the film or points backward.
+  std::optional<Vec2> raster_of(Vec3 p_lens, Vec3 dir) const;
+  // Raster position of a world point seen through a pinhole (convenience for tests).
+  std::optional<Vec2> project(Vec3 p) const { return raster_of(origin_, normalize(p - origin_)); }
+
+  float importance(Vec3 p_lens, Vec3 dir) const;  // We(p_lens, dir): 0 off the film
+  void pdf_we(Vec3 dir, float* pdf_pos, float* pdf_dir) const;
+  std::optional<CameraWiSample> sample_wi(Vec3 ref, Vec2 u_lens) const;
+
+ private:
+  Transform camera_to_world_;
+  int width_ = 0, height_ = 0;
+  float lens_radius_ = 0, focal_distance_ = 1;
+  float screen_min_x_ = -1, screen_max_x_ = 1, screen_min_y_ = -1, screen_max_y_ = 1;
+  float tan_half_fov_ = 1;
+  float image_plane_area_ = 4;
+  Vec3 origin_, forward_;
+};
+
+}  // namespace caustica

@@ -1,0 +1,90 @@
+// The immutable scene: geometry in an Embree BVH, materials, lights, the camera, and the
+// one power-based light distribution. Integrators trace rays only through this class.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/vec.h"
+#include "scene/camera.h"
+#include "scene/interaction.h"
+#include "scene/shapes.h"
+
+namespace caustica {
+
+class Material;
+class Light;
+class LightSampler;
+
+// Render settings a scene file may carry (pbrt's Sampler/Integrator/Film); the CLI overrides.
+struct SceneSettings {
+  int spp = 0;               // 0: not set by the scene
+  int max_depth = 0;         // 0: not set
+  std::string integrator;    // empty: not set
+  std::string output_name;   // pbrt Film "filename", informational
+};
+
+// Everything a loader or built-in scene hands over. Area lights are created by SceneBuilder.
+struct SceneData {
+  struct MeshEntry {
+    TriangleMesh mesh;
+    std::shared_ptr<const Material> material;
+    uint32_t first_light = UINT32_MAX;  // index of triangle 0's area light, or none
+  };
+  struct SphereEntry {
+    Sphere sphere;
+    std::shared_ptr<const Material> material;
+    uint32_t light = UINT32_MAX;  // index of its area light, or none
+  };
+  std::vector<MeshEntry> meshes;
+  std::vector<SphereEntry> spheres;
+  std::vector<std::shared_ptr<class Light>> lights;
+  CameraParams camera;
+  SceneSettings settings;
+  std::string name;
+};
+
+class Scene {
+ public:
+  explicit Scene(SceneData data);
+  ~Scene();
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+
+  // Closest hit in (0, ray.tmax). Each call counts one ray (per-thread counters).
+  bool intersect(const Ray& ray, SurfaceInteraction* si) const;
+  // True if anything blocks the ray in (0, ray.tmax). Counts one ray.
+  bool occluded(const Ray& ray) const;
+
+  const Camera& camera() const { return camera_; }
+  const std::vector<const Light*>& lights() const { return light_ptrs_; }
+  const std::vector<const Light*>& infinite_lights() const { return infinite_lights_; }
+  const LightSampler& light_sampler() const { return *light_sampler_; }
+  Bounds3 bounds() const { return bounds_; }
+  const SceneSettings& settings() const { return settings_; }
+  const std::string& name() const { return name_; }
+  size_t triangle_count() const;
+  size_t sphere_count() const { return spheres_.size(); }
+
+  // Rays traced through intersect/occluded since construction (all threads).
+  uint64_t rays_traced() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::vector<SceneData::MeshEntry> meshes_;
+  std::vector<SceneData::SphereEntry> spheres_;
+  std::vector<std::shared_ptr<Light>> lights_;
+  std::vector<const Light*> light_ptrs_, infinite_lights_;
+  std::unique_ptr<LightSampler> light_sampler_;
+  Camera camera_;
+  Bounds3 bounds_;
+  SceneSettings settings_;
+  std::string name_;
+
+  friend struct SceneAccess;
+};
+
+}  // namespace caustica

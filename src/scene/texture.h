@@ -1,0 +1,85 @@
+// Textures: functions of the surface point that materials evaluate at each hit.
+// All textures are RGB; scalar parameters (roughness) read the average channel.
+#pragma once
+
+#include <memory>
+
+#include "core/rgb.h"
+#include "core/vec.h"
+
+namespace caustica {
+
+class Image;
+
+struct TextureContext {
+  Vec2 uv;
+  Vec3 p;
+};
+
+class Texture {
+ public:
+  virtual ~Texture() = default;
+  virtual Rgb eval(const TextureContext& ctx) const = 0;
+  float eval_float(const TextureContext& ctx) const { return eval(ctx).average(); }
+  // True if eval() returns the same value everywhere (lets materials skip work).
+  virtual bool is_constant() const { return false; }
+};
+
+using TexturePtr = std::shared_ptr<const Texture>;
+
+class ConstantTexture final : public Texture {
+ public:
+  explicit ConstantTexture(Rgb value) : value_(value) {}
+  Rgb eval(const TextureContext&) const override { return value_; }
+  bool is_constant() const override { return true; }
+  Rgb value() const { return value_; }
+
+ private:
+  Rgb value_;
+};
+
+// How uv maps into a texture: (u * uscale + udelta, v * vscale + vdelta), as pbrt-v4's UVMapping.
+struct UvMapping {
+  float su = 1, sv = 1, du = 0, dv = 0;
+  Vec2 map(Vec2 uv) const { return {uv.x * su + du, uv.y * sv + dv}; }
+};
+
+// Bilinearly filtered image lookup with repeat wrapping. pbrt convention: v = 0 is the
+// bottom row of the image (images are stored top row first).
+class ImageTexture final : public Texture {
+ public:
+  ImageTexture(std::shared_ptr<const Image> image, UvMapping mapping, Rgb scale = Rgb(1.f), bool invert = false);
+  Rgb eval(const TextureContext& ctx) const override;
+
+ private:
+  std::shared_ptr<const Image> image_;
+  UvMapping mapping_;
+  Rgb scale_;
+  bool invert_;
+};
+
+// 2D checkerboard in uv: tex1 where floor(u) + floor(v) is even, tex2 otherwise.
+class CheckerboardTexture final : public Texture {
+ public:
+  CheckerboardTexture(TexturePtr tex1, TexturePtr tex2, UvMapping mapping)
+      : tex1_(std::move(tex1)), tex2_(std::move(tex2)), mapping_(mapping) {}
+  Rgb eval(const TextureContext& ctx) const override;
+
+ private:
+  TexturePtr tex1_, tex2_;
+  UvMapping mapping_;
+};
+
+// Product of two textures (pbrt-v4 "scale": tex * scale).
+class ScaleTexture final : public Texture {
+ public:
+  ScaleTexture(TexturePtr tex, TexturePtr scale) : tex_(std::move(tex)), scale_(std::move(scale)) {}
+  Rgb eval(const TextureContext& ctx) const override { return tex_->eval(ctx) * scale_->eval(ctx); }
+
+ private:
+  TexturePtr tex_, scale_;
+};
+
+inline TexturePtr make_constant_texture(Rgb v) { return std::make_shared<ConstantTexture>(v); }
+
+}  // namespace caustica

@@ -1,5 +1,6 @@
 // Display transform for PNG output, kept deliberately simple and documented:
-//   display = clamp(linear * 2^exposure, 0, 1), then the sRGB transfer curve.
+//   display = srgb_oetf(clamp(linear * 2^exposure, 0, 1)), channel by channel,
+// with NaN mapped to 0 (+inf to 1, -inf to 0). No tone curve, no hue-preserving clamp.
 // That is what pbrt-v4's `imgtool convert` does by default, so PNGs of the two renderers
 // compare directly. EXR output is never tone mapped.
 #pragma once

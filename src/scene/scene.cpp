@@ -113,6 +113,7 @@ Scene::Scene(SceneData data)
       meshes_(std::move(data.meshes)),
       spheres_(std::move(data.spheres)),
       lights_(std::move(data.lights)),
+      camera_params_(data.camera),
       camera_(data.camera),
       settings_(std::move(data.settings)),
       name_(std::move(data.name)) {
@@ -180,6 +181,13 @@ Scene::Scene(SceneData data)
 }
 
 Scene::~Scene() = default;
+
+void Scene::override_resolution(int width, int height) {
+  if (width <= 0 || height <= 0) throw std::invalid_argument("resolution must be positive");
+  camera_params_.width = width;
+  camera_params_.height = height;
+  camera_ = Camera(camera_params_);
+}
 
 size_t Scene::triangle_count() const {
   size_t n = 0;

@@ -59,6 +59,9 @@ class Scene {
   bool occluded(const Ray& ray) const;
 
   const Camera& camera() const { return camera_; }
+  // Re-creates the camera at another film resolution (command-line override; call before
+  // rendering, never during).
+  void override_resolution(int width, int height);
   const std::vector<const Light*>& lights() const { return light_ptrs_; }
   const std::vector<const Light*>& infinite_lights() const { return infinite_lights_; }
   const LightSampler& light_sampler() const { return *light_sampler_; }
@@ -79,6 +82,7 @@ class Scene {
   std::vector<std::shared_ptr<Light>> lights_;
   std::vector<const Light*> light_ptrs_, infinite_lights_;
   std::unique_ptr<LightSampler> light_sampler_;
+  CameraParams camera_params_;
   Camera camera_;
   Bounds3 bounds_;
   SceneSettings settings_;

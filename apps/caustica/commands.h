@@ -1,0 +1,20 @@
+// Subcommands of the `caustica` binary. Each registers its options on the CLI11 app and
+// returns the process exit code when run: 0 success, 1 runtime failure, 2 bad input.
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace caustica::cli {
+
+using Runner = std::function<int()>;
+
+Runner add_render_command(CLI::App& app);
+Runner add_scenes_command(CLI::App& app);
+
+// Parses a name against a list; on failure prints "unknown <what> 'x'; valid: a, b" and
+// returns false.
+bool check_name(const std::string& what, const std::string& value, const std::vector<std::string>& valid);
+
+}  // namespace caustica::cli

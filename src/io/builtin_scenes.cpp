@@ -1,0 +1,165 @@
+#include "io/builtin_scenes.h"
+
+#include "io/scene_builder.h"
+#include "lights/lights.h"
+#include "materials/materials.h"
+
+namespace caustica {
+
+namespace {
+
+TriangleMesh mesh_from(std::initializer_list<float> p) {
+  TriangleMesh m;
+  const auto* v = p.begin();
+  for (size_t i = 0; i + 2 < p.size(); i += 3) m.positions.emplace_back(v[i], v[i + 1], v[i + 2]);
+  for (uint32_t i = 0; i < m.positions.size(); ++i) m.indices.push_back(i);
+  return m;
+}
+
+MaterialPtr diffuse(Rgb c) { return make_diffuse(make_constant_texture(c)); }
+
+// The camera of shared/scenes/cornell-caustics.pbrt: `Scale -1 1 1` then LookAt, fov 45.
+CameraParams cornell_camera(int w, int h) {
+  CameraParams c;
+  const Transform world_to_camera =
+      Transform::scale({-1, 1, 1}) * Transform::look_at({-0.0439815f, -4.12529f, 0.222539f},
+                                                        {-0.0370952f, -3.12678f, 0.168323f},
+                                                        {0.000373896f, 0.0542148f, 0.998529f});
+  c.camera_to_world = world_to_camera.inverse();
+  c.width = w > 0 ? w : 512;
+  c.height = h > 0 ? h : 512;
+  c.fov_degrees = 45;
+  return c;
+}
+
+// The box of cornell-caustics.pbrt: white floor/ceiling/back, green left, red right, and the
+// light box on the ceiling with its one-sided emitting quad facing down (L = 25.0333).
+void add_cornell_box(SceneBuilder& b) {
+  const Rgb white(0.803922f), green(0.156863f, 0.803922f, 0.172549f), red(0.803922f, 0.152941f, 0.152941f);
+  b.add_mesh(mesh_from({-1.27029f, 1.30455f, -1.28002f, -1.27029f, -1.25549f, -1.28002f, 1.28975f, -1.25549f, -1.28002f,
+                        1.28975f,  -1.25549f, -1.28002f, 1.28975f,  1.30455f,  -1.28002f, -1.27029f, 1.30455f,  -1.28002f,
+                        -1.27029f, 1.30455f,  -1.28002f, 1.28975f,  1.30455f,  -1.28002f, 1.28975f,  1.30455f,  1.28002f,
+                        1.28975f,  1.30455f,  1.28002f,  -1.27029f, 1.30455f,  1.28002f,  -1.27029f, 1.30455f,  -1.28002f,
+                        1.28975f,  1.30455f,  1.28002f,  1.28975f,  -1.25549f, 1.28002f,  -1.27029f, -1.25549f, 1.28002f,
+                        -1.27029f, -1.25549f, 1.28002f,  -1.27029f, 1.30455f,  1.28002f,  1.28975f,  1.30455f,  1.28002f}),
+             diffuse(white));
+  b.add_mesh(mesh_from({-1.27029f, 1.30455f, 1.28002f, -1.27029f, -1.25549f, 1.28002f, -1.27029f, -1.25549f, -1.28002f,
+                        -1.27029f, -1.25549f, -1.28002f, -1.27029f, 1.30455f, -1.28002f, -1.27029f, 1.30455f, 1.28002f}),
+             diffuse(green));
+  b.add_mesh(mesh_from({1.28975f, 1.30455f, -1.28002f, 1.28975f, -1.25549f, -1.28002f, 1.28975f, -1.25549f, 1.28002f,
+                        1.28975f, -1.25549f, 1.28002f, 1.28975f, 1.30455f, 1.28002f, 1.28975f, 1.30455f, -1.28002f}),
+             diffuse(red));
+  b.add_mesh(mesh_from({-0.25f, 0.25f,  1.26002f, 0.25f,  0.25f,  1.28002f, 0.25f,  0.25f,  1.26002f, 0.25f,  0.25f,  1.28002f,
+                        -0.25f, 0.25f,  1.26002f, -0.25f, 0.25f,  1.28002f, -0.25f, 0.25f,  1.28002f, -0.25f, -0.25f, 1.26002f,
+                        -0.25f, -0.25f, 1.28002f, -0.25f, -0.25f, 1.26002f, -0.25f, 0.25f,  1.28002f, -0.25f, 0.25f,  1.26002f,
+                        0.25f,  0.25f,  1.26002f, 0.25f,  -0.25f, 1.28002f, 0.25f,  -0.25f, 1.26002f, 0.25f,  -0.25f, 1.28002f,
+                        0.25f,  0.25f,  1.26002f, 0.25f,  0.25f,  1.28002f, -0.25f, -0.25f, 1.26002f, 0.25f,  -0.25f, 1.26002f,
+                        0.25f,  -0.25f, 1.28002f, 0.25f,  -0.25f, 1.28002f, -0.25f, -0.25f, 1.28002f, -0.25f, -0.25f, 1.26002f}),
+             diffuse(white));
+  const AreaEmission light{Rgb(25.0333f), false};
+  b.add_mesh(mesh_from({-0.25f, 0.25f, 1.26002f, 0.25f, -0.25f, 1.26002f, -0.25f, -0.25f, 1.26002f, 0.25f, -0.25f, 1.26002f,
+                        -0.25f, 0.25f, 1.26002f, 0.25f, 0.25f, 1.26002f}),
+             diffuse(Rgb(0.f)), &light);
+}
+
+constexpr Vec3 kLeftSphere(-0.53885f, 0.02453f, -0.78002f), kRightSphere(0.55831f, 0.02453f, -0.78002f);
+
+void finish_cornell(SceneBuilder& b, int w, int h) {
+  b.set_camera(cornell_camera(w, h));
+  b.settings().spp = 64;
+  b.settings().max_depth = 10;
+}
+
+std::unique_ptr<Scene> cornell(int w, int h) {
+  SceneBuilder b;
+  add_cornell_box(b);
+  b.add_sphere({kLeftSphere, 0.5f}, diffuse(Rgb(0.803922f)));
+  b.add_sphere({kRightSphere, 0.5f}, diffuse(Rgb(0.803922f)));
+  finish_cornell(b, w, h);
+  return b.build("cornell");
+}
+
+std::unique_ptr<Scene> cornell_glass(int w, int h) {
+  SceneBuilder b;
+  add_cornell_box(b);
+  b.add_sphere({kLeftSphere, 0.5f}, make_mirror(Rgb(1.f)));
+  DielectricParams glass;
+  glass.eta = 1.6f;
+  b.add_sphere({kRightSphere, 0.5f}, make_dielectric(glass));
+  finish_cornell(b, w, h);
+  return b.build("cornell-glass");
+}
+
+// Cornell box with two rough metal spheres: glossy transport without delta paths, so every
+// integrator (including light tracing and photon mapping) must converge to the same image.
+std::unique_ptr<Scene> cornell_glossy(int w, int h) {
+  SceneBuilder b;
+  add_cornell_box(b);
+  ConductorParams gold;
+  gold.reflectance = make_constant_texture(Rgb(0.9f, 0.7f, 0.3f));
+  gold.u_roughness = gold.v_roughness = make_constant_texture(Rgb(0.3f));
+  gold.remap_roughness = false;
+  b.add_sphere({kLeftSphere, 0.5f}, make_conductor(gold));
+  ConductorParams steel = gold;
+  steel.reflectance = make_constant_texture(Rgb(0.8f));
+  steel.u_roughness = steel.v_roughness = make_constant_texture(Rgb(0.1f));
+  b.add_sphere({kRightSphere, 0.5f}, make_conductor(steel));
+  finish_cornell(b, w, h);
+  return b.build("cornell-glossy");
+}
+
+// The camera at the origin looking down +y, inside whatever surrounds it.
+CameraParams origin_camera(int w, int h, float fov) {
+  CameraParams c;
+  c.camera_to_world = Transform::look_at({0, 0, 0}, {0, 1, 0}, {0, 0, 1}).inverse();
+  c.width = w;
+  c.height = h;
+  c.fov_degrees = fov;
+  return c;
+}
+
+std::unique_ptr<Scene> env_furnace(int w, int h) {
+  SceneBuilder b;
+  b.add_sphere({{0, 3, 0}, 1.f}, diffuse(Rgb(1.f)));
+  b.add_light(make_uniform_environment(Rgb(1.f)));
+  b.set_camera(origin_camera(w > 0 ? w : 32, h > 0 ? h : 32, 40));
+  b.settings().spp = 64;
+  b.settings().max_depth = 100;
+  return b.build("env-furnace");
+}
+
+}  // namespace
+
+std::unique_ptr<Scene> make_furnace_scene(const FurnaceParams& params, int w, int h) {
+  SceneBuilder b;
+  // A closed sphere seen from inside: its normals face inward (ReverseOrientation), so the
+  // one-sided emitter radiates into the sphere.
+  Sphere s{{0, 0, 0}, 1.f, true};
+  const AreaEmission e{Rgb(params.emission), false};
+  b.add_sphere(s, diffuse(Rgb(params.albedo)), &e);
+  b.set_camera(origin_camera(w, h, 60));
+  b.settings().spp = 64;
+  b.settings().max_depth = 1000;
+  return b.build("furnace");
+}
+
+std::vector<BuiltinSceneInfo> builtin_scenes() {
+  return {
+      {"cornell-glass", "the default: Cornell box with a mirror and a glass sphere (= cornell-caustics.pbrt)"},
+      {"cornell", "Cornell box, diffuse only, area light"},
+      {"cornell-glossy", "Cornell box with two rough metal spheres (no delta paths)"},
+      {"furnace", "camera inside a closed diffuse sphere, albedo 0.5, emitting 1: radiance is exactly 2"},
+      {"env-furnace", "albedo-1 diffuse sphere under a uniform environment of radiance 1: every pixel is 1"},
+  };
+}
+
+std::unique_ptr<Scene> make_builtin_scene(const std::string& name, int w, int h) {
+  if (name == "cornell-glass") return cornell_glass(w, h);
+  if (name == "cornell") return cornell(w, h);
+  if (name == "cornell-glossy") return cornell_glossy(w, h);
+  if (name == "furnace") return make_furnace_scene(FurnaceParams{}, w > 0 ? w : 32, h > 0 ? h : 32);
+  if (name == "env-furnace") return env_furnace(w, h);
+  return nullptr;
+}
+
+}  // namespace caustica

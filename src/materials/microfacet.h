@@ -1,0 +1,71 @@
+// Anisotropic Trowbridge-Reitz (GGX) microfacet distribution with Smith's height-correlated
+// masking-shadowing and visible-normal sampling (Heitz 2018, "Sampling the GGX Distribution of
+// Visible Normals"), as pbrt-v4's TrowbridgeReitzDistribution. Private to materials/.
+#pragma once
+
+#include "core/frame.h"
+#include "core/vec.h"
+
+namespace caustica {
+
+class TrowbridgeReitz {
+ public:
+  TrowbridgeReitz() = default;
+  TrowbridgeReitz(float alpha_x, float alpha_y) : alpha_x_(alpha_x), alpha_y_(alpha_y) {}
+
+  // pbrt-v4's RoughnessToAlpha: user "roughness" -> alpha.
+  static float roughness_to_alpha(float roughness) { return std::sqrt(std::max(roughness, 0.f)); }
+
+  float alpha_x() const { return alpha_x_; }
+  float alpha_y() const { return alpha_y_; }
+  // Below this the lobes are so narrow that they are treated as delta (specular) lobes.
+  bool effectively_smooth() const { return std::max(alpha_x_, alpha_y_) < 1e-3f; }
+
+  // Microfacet normal density D(wm) (projected-area normalised: integral of D cos = 1).
+  float D(Vec3 wm) const {
+    const float tan2 = tan2_theta(wm);
+    if (std::isinf(tan2)) return 0;
+    const float cos4 = sqr(cos2_theta(wm));
+    if (cos4 < 1e-16f) return 0;
+    const float e = tan2 * (sqr(cos_phi(wm) / alpha_x_) + sqr(sin_phi(wm) / alpha_y_));
+    return 1 / (kPi * alpha_x_ * alpha_y_ * cos4 * sqr(1 + e));
+  }
+  // Smith's auxiliary function.
+  float lambda(Vec3 w) const {
+    const float tan2 = tan2_theta(w);
+    if (std::isinf(tan2)) return 0;
+    const float alpha2 = sqr(cos_phi(w) * alpha_x_) + sqr(sin_phi(w) * alpha_y_);
+    return (std::sqrt(1 + alpha2 * tan2) - 1) / 2;
+  }
+  float G1(Vec3 w) const { return 1 / (1 + lambda(w)); }
+  // Height-correlated masking-shadowing.
+  float G(Vec3 wo, Vec3 wi) const { return 1 / (1 + lambda(wo) + lambda(wi)); }
+  // Distribution of normals visible from w: G1(w) / |cos w| D(wm) |w.wm|.
+  float D(Vec3 w, Vec3 wm) const { return G1(w) / abs_cos_theta(w) * D(wm) * abs_dot(w, wm); }
+  float pdf(Vec3 w, Vec3 wm) const { return D(w, wm); }
+
+  // Samples D(w, .) ; for w below the surface it samples the mirrored configuration.
+  Vec3 sample_wm(Vec3 w, Vec2 u) const {
+    const bool flip = w.z < 0;
+    if (flip) w = -w;
+    // Stretch to the hemisphere configuration (alpha = 1).
+    Vec3 wh = normalize(Vec3(alpha_x_ * w.x, alpha_y_ * w.y, w.z));
+    if (wh.z < 0) wh = -wh;
+    const Vec3 t1 = wh.z < 0.99999f ? normalize(cross(Vec3(0, 0, 1), wh)) : Vec3(1, 0, 0);
+    const Vec3 t2 = cross(wh, t1);
+    // Uniform disk point (polar map), warped to the projected visible hemisphere.
+    const float r = std::sqrt(u.x), phi = 2 * kPi * u.y;
+    float px = r * std::cos(phi), py = r * std::sin(phi);
+    const float h = std::sqrt(std::max(0.f, 1 - px * px));
+    py = lerp((1 + wh.z) / 2, h, py);
+    const float pz = std::sqrt(std::max(0.f, 1 - px * px - py * py));
+    const Vec3 nh = px * t1 + py * t2 + pz * wh;
+    const Vec3 wm = normalize(Vec3(alpha_x_ * nh.x, alpha_y_ * nh.y, std::max(1e-6f, nh.z)));
+    return flip ? -wm : wm;
+  }
+
+ private:
+  float alpha_x_ = 0, alpha_y_ = 0;
+};
+
+}  // namespace caustica

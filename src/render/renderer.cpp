@@ -1,0 +1,48 @@
+#include "render/renderer.h"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "render/film.h"
+#include "render/progress.h"
+#include "scene/scene.h"
+
+namespace caustica {
+
+RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudget& budget,
+                    const RenderCallbacks& callbacks) {
+  if (budget.spp <= 0 && budget.seconds <= 0) throw std::invalid_argument("render budget needs spp or seconds");
+  Film film(scene.camera().width(), scene.camera().height());
+  ProgressBar progress(callbacks.progress_label, callbacks.quiet);
+  const auto start = std::chrono::steady_clock::now();
+  const uint64_t rays_before = scene.rays_traced();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+
+  integrator.prepare(scene, film);
+  for (uint32_t it = 0;; ++it) {
+    if (budget.spp > 0 && it >= uint32_t(budget.spp)) break;
+    if (budget.seconds > 0 && it > 0 && elapsed() >= budget.seconds) break;
+    integrator.render_iteration(scene, it, film);
+    film.end_iteration();
+    const double t = elapsed();
+    const double frac_spp = budget.spp > 0 ? double(it + 1) / budget.spp : 0;
+    const double frac_time = budget.seconds > 0 ? t / budget.seconds : 0;
+    const double mrays = t > 0 ? double(scene.rays_traced() - rays_before) / t * 1e-6 : 0;
+    progress.update(std::max(frac_spp, frac_time), mrays, "Mrays/s");
+    if (callbacks.on_iteration && !callbacks.on_iteration(film, it + 1, t)) break;
+  }
+  integrator.finish(scene, film);
+  const double total = elapsed();
+  progress.update(1.0, total > 0 ? double(scene.rays_traced() - rays_before) / total * 1e-6 : 0, "Mrays/s");
+  progress.finish();
+
+  RenderResult r;
+  r.seconds = elapsed();
+  r.image = film.image();
+  r.iterations = film.iterations();
+  r.rays = scene.rays_traced() - rays_before;
+  r.nonfinite = film.nonfinite_count();
+  return r;
+}
+
+}  // namespace caustica

@@ -1,0 +1,39 @@
+// The progressive render loop: iterations until a sample or time budget is met.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "image/image.h"
+#include "integrators/integrator.h"
+
+namespace caustica {
+
+class Scene;
+class Film;
+
+struct RenderBudget {
+  int spp = 0;            // iterations (one sample per pixel each); 0 = not set
+  double seconds = 0;     // wall-clock budget; 0 = not set. Both set: whichever ends first
+};
+
+struct RenderResult {
+  Image image;
+  uint32_t iterations = 0;
+  double seconds = 0;
+  uint64_t rays = 0;
+  uint64_t nonfinite = 0;
+};
+
+struct RenderCallbacks {
+  bool quiet = false;             // no progress bar
+  std::string progress_label = "render";
+  // Called after every iteration with the film; return false to stop early.
+  std::function<bool(const Film&, uint32_t iterations, double seconds)> on_iteration;
+};
+
+RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudget& budget,
+                    const RenderCallbacks& callbacks = {});
+
+}  // namespace caustica

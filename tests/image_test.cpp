@@ -1,4 +1,6 @@
 // Image storage, file formats, atomic writes and the display transform.
+#include "image/image.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -12,7 +14,6 @@
 #include <string>
 #include <vector>
 
-#include "image/image.h"
 #include "image/image_io.h"
 #include "image/tonemap.h"
 
@@ -112,9 +113,9 @@ TEST(Image, BilinearWrapInterpolatesAcrossTheSeam) {
   Image image(2, 1);
   image.at(0, 0) = Rgb(0.f);
   image.at(1, 0) = Rgb(1.f);
-  EXPECT_FLOAT_EQ(image.bilinear_wrap(0.5f, 0.5f).r, 0.5f);   // Between the two centres.
-  EXPECT_FLOAT_EQ(image.bilinear_wrap(0.0f, 0.5f).r, 0.5f);   // Left edge: half the last column.
-  EXPECT_FLOAT_EQ(image.bilinear_wrap(1.25f, 0.5f).r, 0.0f);  // Wraps onto texel 0's centre.
+  EXPECT_FLOAT_EQ(image.bilinear_wrap(0.5f, 0.5f).r, 0.5f);    // Between the two centres.
+  EXPECT_FLOAT_EQ(image.bilinear_wrap(0.0f, 0.5f).r, 0.5f);    // Left edge: half the last column.
+  EXPECT_FLOAT_EQ(image.bilinear_wrap(1.25f, 0.5f).r, 0.0f);   // Wraps onto texel 0's centre.
   EXPECT_FLOAT_EQ(image.bilinear_wrap(-0.25f, 0.5f).r, 1.0f);  // Wraps onto texel 1's centre.
 }
 
@@ -177,6 +178,61 @@ TEST_F(ImageFiles, PngRoundTripWithinQuantisation) {
   const Image linear = read_image(file("a.png"), /*srgb=*/true);
   for (size_t i = 0; i < display.pixel_count(); ++i)
     for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(linear[i][c], srgb_to_linear(encoded[i][c]));
+}
+
+// A minimal valid PNG: one IHDR, one IDAT holding an uncompressed ("stored") zlib stream.
+std::string png_chunk(const std::string& type, const std::string& data) {
+  auto be32 = [](uint32_t v) {
+    return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+  };
+  const std::string body = type + data;
+  uint32_t crc = 0xffffffffu;  // CRC-32 as in the PNG specification, bit by bit.
+  for (unsigned char byte : body) {
+    crc ^= byte;
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  return be32(uint32_t(data.size())) + body + be32(~crc);
+}
+
+std::string png_16bit_rgb(int width, int height, const std::vector<uint16_t>& samples) {
+  std::string raw;  // Filter type 0 per row, then big-endian 16-bit samples.
+  for (int y = 0; y < height; ++y) {
+    raw.push_back(0);
+    for (int i = 0; i < width * 3; ++i) {
+      const uint16_t v = samples[size_t(y) * width * 3 + i];
+      raw += {char(v >> 8), char(v & 0xff)};
+    }
+  }
+  uint32_t a = 1, b = 0;  // Adler-32 of the uncompressed data.
+  for (unsigned char byte : raw) {
+    a = (a + byte) % 65521;
+    b = (b + a) % 65521;
+  }
+  const uint16_t len = uint16_t(raw.size()), nlen = uint16_t(~len);
+  // zlib header (no compression), one final stored block, then the Adler-32 big endian.
+  std::string zlib = {0x78, 0x01, 0x01};
+  zlib += {char(len & 0xff), char(len >> 8), char(nlen & 0xff), char(nlen >> 8)};
+  zlib += raw;
+  const uint32_t adler = (b << 16) | a;
+  zlib += {char(adler >> 24), char(adler >> 16), char(adler >> 8), char(adler)};
+  const std::string ihdr = {
+      0, 0, char(width >> 8), char(width), 0, 0, char(height >> 8), char(height), 16, 2, 0, 0, 0};
+  return std::string("\x89PNG\r\n\x1a\n", 8) + png_chunk("IHDR", ihdr) + png_chunk("IDAT", zlib) +
+         png_chunk("IEND", "");
+}
+
+TEST_F(ImageFiles, Reads16BitPngWithOptionalSrgbDecoding) {
+  const std::vector<uint16_t> samples = {0, 65535, 32768, 1000, 50000, 12345};
+  write_bytes(file("deep.png"), png_16bit_rgb(2, 1, samples));
+  const Image encoded = read_image(file("deep.png"), /*srgb=*/false);
+  const Image linear = read_image(file("deep.png"), /*srgb=*/true);
+  ASSERT_EQ(encoded.width(), 2);
+  ASSERT_EQ(encoded.height(), 1);
+  for (int i = 0; i < 6; ++i) {
+    const float v = samples[i] / 65535.f;
+    EXPECT_FLOAT_EQ(encoded[i / 3][i % 3], v) << i;
+    EXPECT_FLOAT_EQ(linear[i / 3][i % 3], srgb_to_linear(v)) << i;
+  }
 }
 
 TEST_F(ImageFiles, TonemappedPngRoundTripRecoversLinearValues) {
@@ -275,8 +331,8 @@ TEST(Tonemap, ClampsThenAppliesSrgbCurve) {
   linear[1] = Rgb(0.5f);
   linear[2] = Rgb(1.f);
   linear[3] = Rgb(2.f);
-  linear[4] = Rgb(-1.f, std::numeric_limits<float>::quiet_NaN(),
-                  std::numeric_limits<float>::infinity());
+  linear[4] =
+      Rgb(-1.f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity());
   linear[5] = Rgb(0.001f);  // Linear segment of the sRGB curve.
   const Image display = tonemap_srgb(linear);
   EXPECT_EQ(display[0], Rgb(0.f));

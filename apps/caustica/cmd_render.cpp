@@ -30,7 +30,7 @@ struct RenderOptions {
   int threads = 0;
   std::string outfile = "caustica.exr";
   float exposure = 0;
-  std::string mis = "power";
+  std::string mis;  // empty: each integrator's default (pt: power, the bidirectional family: balance)
   std::string resolution;
   uint64_t light_paths = 0;
   float radius = 0, radius_alpha = 0.75f;
@@ -66,7 +66,7 @@ int run_render(const RenderOptions& o) {
     return 2;
   }
   if (!o.integrator.empty() && !check_name("integrator", o.integrator, integrator_names())) return 2;
-  if (!check_name("MIS heuristic", o.mis, {"balance", "power"})) return 2;
+  if (!o.mis.empty() && !check_name("MIS heuristic", o.mis, {"balance", "power"})) return 2;
   int res_w = 0, res_h = 0;
   if (!o.resolution.empty() && (std::sscanf(o.resolution.c_str(), "%dx%d", &res_w, &res_h) != 2 || res_w <= 0 || res_h <= 0)) {
     std::fprintf(stderr, "caustica render: error: --resolution expects WxH, e.g. 256x256, got '%s'\n", o.resolution.c_str());
@@ -98,6 +98,7 @@ int run_render(const RenderOptions& o) {
   settings.max_depth = o.max_depth >= 0 ? o.max_depth : (scene->settings().max_depth > 0 ? scene->settings().max_depth : 10);
   settings.seed = o.seed;
   settings.mis = o.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
+  settings.mis_from_user = !o.mis.empty();
   settings.light_paths = o.light_paths;
   settings.radius = o.radius;
   settings.radius_alpha = o.radius_alpha;
@@ -130,7 +131,7 @@ int run_render(const RenderOptions& o) {
   stats["threads"] = threads;
   stats["seed"] = o.seed;
   stats["max_depth"] = settings.max_depth;
-  stats["mis"] = o.mis;
+  stats["mis"] = o.mis.empty() ? "default" : o.mis;
   stats["time_budget_seconds"] = o.seconds;
   stats["finished_at"] = iso_time_now();
   integrator->report(stats);
@@ -170,7 +171,7 @@ Runner add_render_command(CLI::App& app) {
   cmd->add_option("--threads", opts->threads, "Worker threads (default: all cores)");
   cmd->add_option("--outfile", opts->outfile, "Output file; writes NAME.exr, NAME.png and NAME.json (default caustica.exr)");
   cmd->add_option("--exposure", opts->exposure, "PNG exposure in stops (EXR is never tone mapped)");
-  cmd->add_option("--mis", opts->mis, "MIS heuristic: power (default) or balance");
+  cmd->add_option("--mis", opts->mis, "MIS heuristic: balance or power (default: power for pt, balance for lt/bpt/ppm/bpm/vcm)");
   cmd->add_option("--resolution", opts->resolution, "Override the film resolution, WxH");
   cmd->add_option("--light-paths", opts->light_paths, "Bidirectional: light subpaths per iteration (default: pixel count)");
   cmd->add_option("--radius", opts->radius, "Photon mapping / VCM: initial merge radius (default: from scene size)");

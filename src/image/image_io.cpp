@@ -3,17 +3,17 @@
 // memory and hands the bytes to write_file_atomic.
 #include "image/image_io.h"
 
-#include <fcntl.h>
-#include <stb_image.h>
-#include <stb_image_write.h>
-#include <unistd.h>
-
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfIO.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <fcntl.h>
+#include <stb_image.h>
+#include <stb_image_write.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <bit>
@@ -98,8 +98,7 @@ Image read_exr_unlabelled(const char* path) {
   const Imf::ChannelList& channels = file.header().channels();
   const bool has_rgb =
       channels.findChannel("R") || channels.findChannel("G") || channels.findChannel("B");
-  if (!has_rgb && !channels.findChannel("Y"))
-    throw std::runtime_error("no R, G, B or Y channel");
+  if (!has_rgb && !channels.findChannel("Y")) throw std::runtime_error("no R, G, B or Y channel");
 
   Image image{int(width), int(height)};
   // The slices address pixel (x, y) of the data window; OpenEXR converts half to float and
@@ -195,8 +194,8 @@ Image read_pfm(const std::string& path) {
     const int y = int(height - 1 - file_row);
     for (int64_t x = 0; x < width; ++x) {
       const size_t i = (size_t(file_row) * size_t(width) + size_t(x)) * size_t(channels);
-      image.at(int(x), y) = channels == 3 ? Rgb(value(i), value(i + 1), value(i + 2))
-                                          : Rgb(value(i));
+      image.at(int(x), y) =
+          channels == 3 ? Rgb(value(i), value(i + 1), value(i + 2)) : Rgb(value(i));
     }
   }
   return image;
@@ -209,6 +208,11 @@ struct StbFree {
   void operator()(void* p) const { stbi_image_free(p); }
 };
 
+std::string stb_reason() {
+  const char* reason = stbi_failure_reason();
+  return reason ? reason : "unknown error";
+}
+
 Image read_stb(const std::string& path, bool srgb) {
   const std::string bytes = read_whole_file(path);
   if (bytes.size() > size_t(std::numeric_limits<int>::max())) fail(path, "file too large");
@@ -216,14 +220,14 @@ Image read_stb(const std::string& path, bool srgb) {
   const int len = int(bytes.size());
   int width = 0, height = 0, in_file_channels = 0;
   if (!stbi_info_from_memory(data, len, &width, &height, &in_file_channels))
-    fail(path, std::string("cannot decode image: ") + stbi_failure_reason());
+    fail(path, "cannot decode image: " + stb_reason());
   check_size(path, width, height);
 
   // Grey and grey+alpha are expanded to RGB by stb; alpha is dropped.
   constexpr int kChannels = 3;
   Image image(width, height);
   auto store = [&](auto* pixels, auto to_linear) {
-    if (!pixels) fail(path, std::string("cannot decode image: ") + stbi_failure_reason());
+    if (!pixels) fail(path, "cannot decode image: " + stb_reason());
     for (size_t i = 0; i < image.pixel_count(); ++i)
       image[i] = Rgb(to_linear(pixels[kChannels * i]), to_linear(pixels[kChannels * i + 1]),
                      to_linear(pixels[kChannels * i + 2]));
@@ -333,16 +337,23 @@ void write_file_atomic(const std::string& path, const std::string& contents) {
   // system); pid and a counter keep concurrent writers, in or across processes, apart.
   static std::atomic<unsigned> counter{0};
   const std::filesystem::path target(path);
-  std::string temp_name = ".";
-  temp_name += target.filename().string();
-  temp_name += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-  const std::string temp = (target.parent_path() / temp_name).string();
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  std::string temp;
+  int fd = -1;
+  // O_EXCL never reuses a name; a stale temporary left by a killed process with our pid only
+  // costs another attempt.
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    std::string temp_name = ".";
+    temp_name += target.filename().string();
+    temp_name += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    temp = (target.parent_path() / temp_name).string();
+    fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd >= 0 || errno != EEXIST) break;
+  }
   if (fd < 0) fail(path, std::string("cannot create temporary file: ") + std::strerror(errno));
 
   auto abandon = [&](const char* what) {
     const int err = errno;
-    ::close(fd);  // Harmless if already closed: the error path below never reuses fd.
+    ::close(fd);
     ::unlink(temp.c_str());
     fail(path, std::string(what) + ": " + std::strerror(err));
   };

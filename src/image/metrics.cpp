@@ -33,7 +33,8 @@ double pixel_rel_error(const Rgb& img, const Rgb& ref, double eps) {
 std::vector<double> gaussian_taps(int radius, double sigma) {
   std::vector<double> taps(2 * radius + 1);
   double sum = 0;
-  for (int i = -radius; i <= radius; ++i) sum += taps[i + radius] = std::exp(-0.5 * i * i / (sigma * sigma));
+  for (int i = -radius; i <= radius; ++i)
+    sum += taps[i + radius] = std::exp(-0.5 * i * i / (sigma * sigma));
   for (double& t : taps) t /= sum;
   return taps;
 }
@@ -123,7 +124,8 @@ double ssim(const Image& img, const Image& ref) {
     yy[i] = y[i] * y[i];
     xy[i] = x[i] * y[i];
   }
-  const std::vector<double> mu_x = blur(x, width, height, taps), mu_y = blur(y, width, height, taps);
+  const std::vector<double> mu_x = blur(x, width, height, taps),
+                            mu_y = blur(y, width, height, taps);
   const std::vector<double> e_xx = blur(xx, width, height, taps);
   const std::vector<double> e_yy = blur(yy, width, height, taps);
   const std::vector<double> e_xy = blur(xy, width, height, taps);

@@ -21,6 +21,9 @@ struct IntegratorSettings {
   int max_depth = 10;        // scattering vertices, as pbrt-v4's maxdepth (1 = direct light only)
   uint64_t seed = 0;
   MisHeuristic mis = MisHeuristic::Power;
+  // True when `mis` was chosen by the user (--mis). The bidirectional family then uses `mis`;
+  // otherwise it uses its own default, the balance heuristic (pt always uses `mis`).
+  bool mis_from_user = false;
   // Bidirectional family (ignored by the others).
   uint64_t light_paths = 0;  // light subpaths per iteration; 0 = one per pixel
   float radius = 0;          // initial merge radius; 0 = derived from the scene size

@@ -141,7 +141,7 @@ class SphereAreaLight final : public Light {
     Vec3 p;
     float pdf;
     const float dc2 = distance_squared(ref, c_);
-    if (dc2 <= r_ * r_) {
+    if (use_area_sampling(dc2)) {
       // Inside: uniform area sampling (every direction sees exactly one point).
       p = c_ + r_ * sample_uniform_sphere(u);
       pdf = -1;  // converted below, once the distance is known
@@ -150,7 +150,7 @@ class SphereAreaLight final : public Light {
       // point on the sphere it reaches computed analytically (no ray-sphere intersection, which
       // loses precision near the silhouette). alpha is the angle at the centre between the
       // direction back to ref and the sampled point.
-      const Cone cone = cone_from(dc2);
+      const Cone cone = cone_from(distance_squared(ref, c_));
       float cos_theta = (cone.cos_max - 1) * u.x + 1;
       float sin2_theta = 1 - cos_theta * cos_theta;
       if (cone.small) {
@@ -196,7 +196,7 @@ class SphereAreaLight final : public Light {
     const Vec3 n = emit_normal(p_light);
     if (!emits_toward(n, -wi)) return 0.f;
     const float dc2 = distance_squared(ref, c_);
-    if (dc2 <= r_ * r_) return area_to_solid_angle(inv_area_, distance_squared(ref, p_light), abs_dot(n, wi));
+    if (use_area_sampling(dc2)) return area_to_solid_angle(inv_area_, distance_squared(ref, p_light), abs_dot(n, wi));
     return cone_from(dc2).pdf;
   }
 
@@ -226,10 +226,23 @@ class SphereAreaLight final : public Light {
   }
 
  private:
+  // Points on the sphere itself (shading points of the emitter, which land on either side of it
+  // by rounding) count as inside, so that they see the whole sphere by area sampling; pbrt-v4
+  // gets the same effect by offsetting the reference point along its normal first. Cone
+  // sampling from there would collapse onto ref's own neighbourhood. Area sampling from a
+  // point just outside stays unbiased (the far side is then occluded by the near side).
+  bool treat_as_inside(Vec3 ref) const { return distance_squared(ref, c_) <= r_ * r_ * (1 + 1e-4f); }
+
   struct Cone {
     float sin2_max, sin_max, cos_max, pdf;
     bool small;  // below ~1.5 degrees: 1 - cos_max by its Taylor series (pbrt-v4)
   };
+  // Inside, or on the surface up to rounding (a reference point on this very sphere, as in
+  // the furnace): uniform area sampling, valid from anywhere. The cone of a point on the
+  // surface degenerates to a hemisphere whose "nearest points" collapse onto the point itself;
+  // pbrt-v4 avoids it by offsetting the reference point, we by a relative tolerance. Shared by
+  // sample_li and pdf_li so both always take the same branch.
+  bool use_area_sampling(float dist_to_center2) const { return dist_to_center2 <= r_ * r_ * (1.f + 1e-4f); }
   // Shared by sample_li and pdf_li so that both report bit-identical densities.
   Cone cone_from(float dist_to_center2) const {
     Cone c;

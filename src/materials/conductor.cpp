@@ -92,7 +92,8 @@ class ConductorMaterial final : public Material {
   explicit ConductorMaterial(const ConductorParams& p) : p_(p) {}
   Bsdf bsdf(const SurfaceInteraction& si, ScratchArena& arena) const override {
     const TextureContext ctx{si.uv, si.p};
-    const TrowbridgeReitz distrib = eval_distribution(p_.u_roughness, p_.v_roughness, p_.remap_roughness, ctx);
+    const TrowbridgeReitz distrib =
+        eval_distribution(p_.u_roughness, p_.v_roughness, p_.remap_roughness, ctx);
     Rgb eta, k;
     if (p_.reflectance) {
       // pbrt-v4 ConductorMaterial: the eta = 1 conductor whose normal reflectance is r.

@@ -6,7 +6,6 @@
 //                 remaproughness             default true (roughness -> alpha = sqrt)
 // thindielectric  eta                        float  default 1.5  IOR of the thin slab
 #include "materials/dielectric_bxdf.h"
-
 #include "materials/fresnel.h"
 #include "materials/materials.h"
 #include "materials/roughness.h"
@@ -14,11 +13,15 @@
 namespace caustica {
 
 uint32_t DielectricBxDF::flags() const {
-  const uint32_t fl = eta_ == 1 ? kBxdfTransmission : (kBxdfReflection | kBxdfTransmission);
-  return fl | (distrib_.effectively_smooth() ? kBxdfSpecular : kBxdfGlossy);
+  // pbrt-v4 reports a rough eta == 1 interface as Glossy although it only ever samples a delta
+  // transmission; here it is Specular, so that is_delta() agrees with what sample() returns.
+  if (eta_ == 1) return kBxdfSpecularTransmission;
+  return kBxdfReflection | kBxdfTransmission |
+         (distrib_.effectively_smooth() ? kBxdfSpecular : kBxdfGlossy);
 }
 
-std::optional<BsdfSample> DielectricBxDF::sample(Vec3 wo, float uc, Vec2 u, TransportMode mode, Lobes lobes) const {
+std::optional<BsdfSample> DielectricBxDF::sample(Vec3 wo, float uc, Vec2 u, TransportMode mode,
+                                                 Lobes lobes) const {
   if (eta_ == 1 || distrib_.effectively_smooth()) {
     // Delta reflection and refraction, chosen in proportion to Fresnel.
     const float R = fr_dielectric(cos_theta(wo), eta_), T = 1 - R;
@@ -55,7 +58,8 @@ std::optional<BsdfSample> DielectricBxDF::sample(Vec3 wo, float uc, Vec2 u, Tran
     s.wi = reflect(wo, wm);
     if (!same_hemisphere(wo, s.wi)) return std::nullopt;
     s.pdf = distrib_.pdf(wo, wm) / (4 * abs_dot(wo, wm)) * pr / (pr + pt);
-    s.f = Rgb(distrib_.D(wm) * distrib_.G(wo, s.wi) * R / std::abs(4 * cos_theta(s.wi) * cos_theta(wo)));
+    s.f = Rgb(distrib_.D(wm) * distrib_.G(wo, s.wi) * R /
+              std::abs(4 * cos_theta(s.wi) * cos_theta(wo)));
     s.flags = kBxdfGlossyReflection;
     return s;
   }
@@ -104,7 +108,8 @@ Rgb DielectricBxDF::f(Vec3 wo, Vec3 wi, TransportMode mode) const {
   if (cos_i * cos_o > 0)
     return Rgb(distrib_.D(wm) * distrib_.G(wo, wi) * F / std::abs(4 * cos_i * cos_o));
   const float denom = sqr(dot(wi, wm) + dot(wo, wm) / etap) * cos_i * cos_o;
-  float ft = distrib_.D(wm) * (1 - F) * distrib_.G(wo, wi) * std::abs(dot(wi, wm) * dot(wo, wm) / denom);
+  float ft =
+      distrib_.D(wm) * (1 - F) * distrib_.G(wo, wi) * std::abs(dot(wi, wm) * dot(wo, wm) / denom);
   if (mode == TransportMode::Radiance) ft /= sqr(etap);
   return Rgb(ft);
 }
@@ -163,7 +168,8 @@ class DielectricMaterial final : public Material {
   explicit DielectricMaterial(const DielectricParams& p) : p_(p) {}
   Bsdf bsdf(const SurfaceInteraction& si, ScratchArena& arena) const override {
     const TextureContext ctx{si.uv, si.p};
-    const TrowbridgeReitz distrib = eval_distribution(p_.u_roughness, p_.v_roughness, p_.remap_roughness, ctx);
+    const TrowbridgeReitz distrib =
+        eval_distribution(p_.u_roughness, p_.v_roughness, p_.remap_roughness, ctx);
     return Bsdf(arena.make<DielectricBxDF>(p_.eta, distrib), si.shading, si.ng);
   }
   const char* name() const override { return "dielectric"; }
@@ -192,6 +198,8 @@ MaterialPtr make_dielectric(const DielectricParams& params) {
   return std::make_shared<DielectricMaterial>(p);
 }
 
-MaterialPtr make_thin_dielectric(float eta) { return std::make_shared<ThinDielectricMaterial>(eta > 0 ? eta : 1.f); }
+MaterialPtr make_thin_dielectric(float eta) {
+  return std::make_shared<ThinDielectricMaterial>(eta > 0 ? eta : 1.f);
+}
 
 }  // namespace caustica

@@ -23,9 +23,12 @@ class DielectricBxDF final : public BxDF {
   std::optional<BsdfSample> sample(Vec3 wo, float uc, Vec2 u, TransportMode mode) const override {
     return sample(wo, uc, u, mode, Lobes::All);
   }
-  float pdf(Vec3 wo, Vec3 wi, TransportMode mode) const override { return pdf(wo, wi, mode, Lobes::All); }
+  float pdf(Vec3 wo, Vec3 wi, TransportMode mode) const override {
+    return pdf(wo, wi, mode, Lobes::All);
+  }
 
-  std::optional<BsdfSample> sample(Vec3 wo, float uc, Vec2 u, TransportMode mode, Lobes lobes) const;
+  std::optional<BsdfSample> sample(Vec3 wo, float uc, Vec2 u, TransportMode mode,
+                                   Lobes lobes) const;
   float pdf(Vec3 wo, Vec3 wi, TransportMode mode, Lobes lobes) const;
 
  private:

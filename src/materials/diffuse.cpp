@@ -17,7 +17,8 @@ class DiffuseTransmissionBxDF final : public BxDF {
   DiffuseTransmissionBxDF(Rgb r, Rgb t) : r_(r), t_(t) {}
 
   uint32_t flags() const override {
-    uint32_t fl = (r_.is_black() ? 0u : kBxdfDiffuseReflection) | (t_.is_black() ? 0u : kBxdfDiffuseTransmission);
+    uint32_t fl = (r_.is_black() ? 0u : kBxdfDiffuseReflection) |
+                  (t_.is_black() ? 0u : kBxdfDiffuseTransmission);
     return fl ? fl : uint32_t(kBxdfDiffuseReflection);  // black: see DiffuseBxDF::flags
   }
   Rgb f(Vec3 wo, Vec3 wi, TransportMode) const override {
@@ -88,10 +89,12 @@ MaterialPtr make_diffuse(TexturePtr reflectance) {
   return std::make_shared<DiffuseMaterial>(std::move(reflectance));
 }
 
-MaterialPtr make_diffuse_transmission(TexturePtr reflectance, TexturePtr transmittance, float scale) {
+MaterialPtr make_diffuse_transmission(TexturePtr reflectance, TexturePtr transmittance,
+                                      float scale) {
   if (!reflectance) reflectance = make_constant_texture(Rgb(0.25f));
   if (!transmittance) transmittance = make_constant_texture(Rgb(0.25f));
-  return std::make_shared<DiffuseTransmissionMaterial>(std::move(reflectance), std::move(transmittance), scale);
+  return std::make_shared<DiffuseTransmissionMaterial>(std::move(reflectance),
+                                                       std::move(transmittance), scale);
 }
 
 }  // namespace caustica

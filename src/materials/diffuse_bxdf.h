@@ -22,7 +22,9 @@ class DiffuseBxDF final : public BxDF {
   std::optional<BsdfSample> sample(Vec3 wo, float uc, Vec2 u, TransportMode mode) const override {
     return sample(wo, uc, u, mode, Lobes::All);
   }
-  float pdf(Vec3 wo, Vec3 wi, TransportMode mode) const override { return pdf(wo, wi, mode, Lobes::All); }
+  float pdf(Vec3 wo, Vec3 wi, TransportMode mode) const override {
+    return pdf(wo, wi, mode, Lobes::All);
+  }
 
   std::optional<BsdfSample> sample(Vec3 wo, float, Vec2 u, TransportMode, Lobes lobes) const {
     if (!has(lobes, Lobes::Reflection)) return std::nullopt;

@@ -41,7 +41,8 @@ inline float fr_complex(float cos_i, std::complex<float> eta) {
   return (std::norm(r_parl) + std::norm(r_perp)) / 2;
 }
 inline Rgb fr_complex(float cos_i, Rgb eta, Rgb k) {
-  return {fr_complex(cos_i, {eta.r, k.r}), fr_complex(cos_i, {eta.g, k.g}), fr_complex(cos_i, {eta.b, k.b})};
+  return {fr_complex(cos_i, {eta.r, k.r}), fr_complex(cos_i, {eta.g, k.g}),
+          fr_complex(cos_i, {eta.b, k.b})};
 }
 
 // Refraction of wi (pointing away from the surface) through the interface with normal n and

@@ -44,10 +44,9 @@ class TrowbridgeReitz {
   float D(Vec3 w, Vec3 wm) const { return G1(w) / abs_cos_theta(w) * D(wm) * abs_dot(w, wm); }
   float pdf(Vec3 w, Vec3 wm) const { return D(w, wm); }
 
-  // Samples D(w, .) ; for w below the surface it samples the mirrored configuration.
+  // Samples D(w, .). The normal is always in the +z hemisphere; for w below the surface it
+  // is a normal visible from -w (D(w, wm) is symmetric under w -> -w).
   Vec3 sample_wm(Vec3 w, Vec2 u) const {
-    const bool flip = w.z < 0;
-    if (flip) w = -w;
     // Stretch to the hemisphere configuration (alpha = 1).
     Vec3 wh = normalize(Vec3(alpha_x_ * w.x, alpha_y_ * w.y, w.z));
     if (wh.z < 0) wh = -wh;
@@ -60,8 +59,7 @@ class TrowbridgeReitz {
     py = lerp((1 + wh.z) / 2, h, py);
     const float pz = std::sqrt(std::max(0.f, 1 - px * px - py * py));
     const Vec3 nh = px * t1 + py * t2 + pz * wh;
-    const Vec3 wm = normalize(Vec3(alpha_x_ * nh.x, alpha_y_ * nh.y, std::max(1e-6f, nh.z)));
-    return flip ? -wm : wm;
+    return normalize(Vec3(alpha_x_ * nh.x, alpha_y_ * nh.y, std::max(1e-6f, nh.z)));
   }
 
  private:

@@ -14,7 +14,8 @@ namespace {
 
 float hash_to_unit_float(Vec3 p, Vec3 wo) {
   uint64_t h = 0x6d69786d6174ull;  // "mixmat"
-  for (const float v : {p.x, p.y, p.z, wo.x, wo.y, wo.z}) h = hash_combine(h, std::bit_cast<uint32_t>(v));
+  for (const float v : {p.x, p.y, p.z, wo.x, wo.y, wo.z})
+    h = hash_combine(h, std::bit_cast<uint32_t>(v));
   return std::min(kOneMinusEpsilon, float(h >> 40) * 0x1p-24f);
 }
 

@@ -7,7 +7,8 @@
 namespace caustica {
 
 // Null textures mean roughness 0 (smooth). With `remap`, values go through RoughnessToAlpha.
-inline TrowbridgeReitz eval_distribution(const TexturePtr& u_roughness, const TexturePtr& v_roughness, bool remap,
+inline TrowbridgeReitz eval_distribution(const TexturePtr& u_roughness,
+                                         const TexturePtr& v_roughness, bool remap,
                                          const TextureContext& ctx) {
   float u = u_roughness ? u_roughness->eval_float(ctx) : 0.f;
   float v = v_roughness ? v_roughness->eval_float(ctx) : u;

@@ -16,7 +16,10 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
   ProgressBar progress(callbacks.progress_label, callbacks.quiet);
   const auto start = std::chrono::steady_clock::now();
   const uint64_t rays_before = scene.rays_traced();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  double paused = 0;  // seconds spent in callbacks, not counted as render time
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - paused;
+  };
 
   integrator.prepare(scene, film);
   for (uint32_t it = 0;; ++it) {
@@ -29,7 +32,12 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
     const double frac_time = budget.seconds > 0 ? t / budget.seconds : 0;
     const double mrays = t > 0 ? double(scene.rays_traced() - rays_before) / t * 1e-6 : 0;
     progress.update(std::max(frac_spp, frac_time), mrays, "Mrays/s");
-    if (callbacks.on_iteration && !callbacks.on_iteration(film, it + 1, t)) break;
+    if (callbacks.on_iteration) {
+      const auto before = std::chrono::steady_clock::now();
+      const bool go_on = callbacks.on_iteration(film, it + 1, t);
+      paused += std::chrono::duration<double>(std::chrono::steady_clock::now() - before).count();
+      if (!go_on) break;
+    }
   }
   integrator.finish(scene, film);
   const double total = elapsed();

@@ -29,7 +29,9 @@ struct RenderResult {
 struct RenderCallbacks {
   bool quiet = false;             // no progress bar
   std::string progress_label = "render";
-  // Called after every iteration with the film; return false to stop early.
+  // Called after every iteration with the film and the render time so far; return false to
+  // stop early. Time spent inside the callback (e.g. error snapshots) is not render time:
+  // it is excluded from the time budget and from the reported seconds.
   std::function<bool(const Film&, uint32_t iterations, double seconds)> on_iteration;
 };
 

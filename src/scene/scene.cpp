@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 #include <tbb/enumerable_thread_specific.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -98,6 +99,7 @@ struct Scene::Impl {
   RTCScene scene = nullptr;
   unsigned sphere_geom_id = RTC_INVALID_GEOMETRY_ID;
   std::vector<int> mesh_of_geom;  // Embree geometry id -> mesh index (-1: spheres)
+  std::vector<uint32_t> first_primitive;  // Embree geometry id -> its first dense primitive index
   SphereGeometry sphere_geometry{};
   mutable tbb::enumerable_thread_specific<uint64_t> rays{0};
   std::string error;
@@ -164,6 +166,13 @@ Scene::Scene(SceneData data)
     }
   }
   rtcCommitScene(im.scene);
+  // Dense primitive indices in geometry-id order (ids are assigned consecutively from 0).
+  im.first_primitive.assign(im.mesh_of_geom.size(), 0);
+  for (size_t g = 0, next = 0; g < im.mesh_of_geom.size(); ++g) {
+    im.first_primitive[g] = uint32_t(next);
+    if (g == im.sphere_geom_id) next += spheres_.size();
+    else if (im.mesh_of_geom[g] >= 0) next += meshes_[im.mesh_of_geom[g]].mesh.triangle_count();
+  }
   if (!im.error.empty()) throw std::runtime_error("Embree: " + im.error);
 
   if (bounds_.empty()) bounds_.extend(Vec3(0, 0, 0));
@@ -233,16 +242,22 @@ bool Scene::intersect(const Ray& ray, SurfaceInteraction* si) const {
   rtcIntersect1(impl_->scene, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
-  const Vec3 d = ray.d;
   si->t = rh.ray.tfar;
-  si->wo = -normalize(d);
-  si->geom_id = rh.hit.geomID;
-  si->prim_id = rh.hit.primID;
+  si->wo = -normalize(ray.d);
+  Vec3 p_sphere;
+  if (rh.hit.geomID == impl_->sphere_geom_id) p_sphere = ray.o + ray.d * si->t;
+  complete_hit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, p_sphere, si);
+  return true;
+}
 
-  if (rh.hit.geomID == impl_->sphere_geom_id) {
-    const auto& e = spheres_[rh.hit.primID];
+void Scene::complete_hit(uint32_t geom_id, uint32_t prim_id, float b1, float b2, Vec3 p_sphere,
+                         SurfaceInteraction* si) const {
+  si->geom_id = geom_id;
+  si->prim_id = prim_id;
+  if (geom_id == impl_->sphere_geom_id) {
+    const auto& e = spheres_[prim_id];
     const Sphere& s = e.sphere;
-    Vec3 p = ray.o + d * si->t;
+    Vec3 p = p_sphere;
     Vec3 local = p - s.center;
     const float len = length(local);
     local = len > 0 ? local * (s.radius / len) : Vec3(0, 0, s.radius);
@@ -260,15 +275,14 @@ bool Scene::intersect(const Ray& ray, SurfaceInteraction* si) const {
     si->shading = Frame::from_normal_tangent(n, dpdu);
     si->material = e.material.get();
     si->area_light = e.light != UINT32_MAX ? lights_[e.light].get() : nullptr;
-    return true;
+    return;
   }
 
-  const auto& e = meshes_[impl_->mesh_of_geom[rh.hit.geomID]];
+  const auto& e = meshes_[impl_->mesh_of_geom[geom_id]];
   const TriangleMesh& m = e.mesh;
-  const uint32_t i0 = m.indices[3 * rh.hit.primID], i1 = m.indices[3 * rh.hit.primID + 1],
-                 i2 = m.indices[3 * rh.hit.primID + 2];
+  const uint32_t i0 = m.indices[3 * prim_id], i1 = m.indices[3 * prim_id + 1], i2 = m.indices[3 * prim_id + 2];
   const Vec3 p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
-  const float b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.f - b1 - b2;
+  const float b0 = 1.f - b1 - b2;
   si->p = p0 * b0 + p1 * b1 + p2 * b2;
   si->p_error = (abs(p0 * b0) + abs(p1 * b1) + abs(p2 * b2)) * (8 * gamma_bound(7));
   Vec3 ng = normalize(cross(p1 - p0, p2 - p0));
@@ -297,8 +311,36 @@ bool Scene::intersect(const Ray& ray, SurfaceInteraction* si) const {
   si->ng = ng;
   si->shading = Frame::from_normal_tangent(ns, dpdu);
   si->material = e.material.get();
-  si->area_light = e.first_light != UINT32_MAX ? lights_[e.first_light + rh.hit.primID].get() : nullptr;
-  return true;
+  si->area_light = e.first_light != UINT32_MAX ? lights_[e.first_light + prim_id].get() : nullptr;
+}
+
+uint32_t Scene::primitive_index(const SurfaceInteraction& si) const {
+  return impl_->first_primitive[si.geom_id] + si.prim_id;
+}
+
+SurfaceInteraction Scene::interaction_at(uint32_t primitive_index, Vec3 p, Vec3 wo) const {
+  const auto& first = impl_->first_primitive;
+  // The geometry whose range [first[g], first[g + 1]) holds the index.
+  const uint32_t geom_id = uint32_t(std::upper_bound(first.begin(), first.end(), primitive_index) - first.begin()) - 1;
+  const uint32_t prim_id = primitive_index - first[geom_id];
+  SurfaceInteraction si;
+  si.wo = wo;
+  float b1 = 0, b2 = 0;
+  if (geom_id != impl_->sphere_geom_id) {
+    // Barycentrics of p's projection onto the triangle's plane.
+    const TriangleMesh& m = meshes_[impl_->mesh_of_geom[geom_id]].mesh;
+    const Vec3 p0 = m.positions[m.indices[3 * prim_id]], p1 = m.positions[m.indices[3 * prim_id + 1]],
+               p2 = m.positions[m.indices[3 * prim_id + 2]];
+    const Vec3 e1 = p1 - p0, e2 = p2 - p0, d = p - p0;
+    const float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), d1 = dot(d, e1), d2 = dot(d, e2);
+    const float det = d11 * d22 - d12 * d12;
+    if (det > 0) {
+      b1 = clamp((d22 * d1 - d12 * d2) / det, 0.f, 1.f);
+      b2 = clamp((d11 * d2 - d12 * d1) / det, 0.f, 1.f - b1);
+    }
+  }
+  complete_hit(geom_id, prim_id, b1, b2, p, &si);
+  return si;
 }
 
 }  // namespace caustica

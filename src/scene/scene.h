@@ -74,7 +74,17 @@ class Scene {
   // Rays traced through intersect/occluded since construction (all threads).
   uint64_t rays_traced() const;
 
+  // Compact primitive references for stored path vertices (the bidirectional core keeps light
+  // vertices small and rebuilds their hit records on demand): a dense index over all triangles
+  // and spheres, and the hit record at point p of that primitive (p is projected onto it) as
+  // intersect() reports it, with wo set to the given direction. Does not count a ray.
+  uint32_t primitive_index(const SurfaceInteraction& si) const;
+  SurfaceInteraction interaction_at(uint32_t primitive_index, Vec3 p, Vec3 wo) const;
+
  private:
+  void complete_hit(uint32_t geom_id, uint32_t prim_id, float b1, float b2, Vec3 p_sphere,
+                    SurfaceInteraction* si) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::vector<SceneData::MeshEntry> meshes_;

@@ -44,10 +44,14 @@ struct UvMapping {
   Vec2 map(Vec2 uv) const { return {uv.x * su + du, uv.y * sv + dv}; }
 };
 
-// Bilinearly filtered image lookup with repeat wrapping. pbrt convention: v = 0 is the
-// bottom row of the image (images are stored top row first).
+// Bilinearly filtered image lookup with repeat wrapping, as pbrt-v4's "imagemap" texture with
+// filter "bilinear" and wrap "repeat" (no MIP mapping). pbrt convention: (s, t) = mapping(uv)
+// and t = 0 is the bottom of the image (images are stored top row first), so the lookup is at
+// (s, 1 - t); texel centres sit at half-integer multiples of 1/width, 1/height. The result is
+// max(0, invert ? 1 - scale * texel : scale * texel), as pbrt-v4 computes it.
 class ImageTexture final : public Texture {
  public:
+  // Throws std::invalid_argument if `image` is null or empty.
   ImageTexture(std::shared_ptr<const Image> image, UvMapping mapping, Rgb scale = Rgb(1.f), bool invert = false);
   Rgb eval(const TextureContext& ctx) const override;
 
@@ -58,7 +62,8 @@ class ImageTexture final : public Texture {
   bool invert_;
 };
 
-// 2D checkerboard in uv: tex1 where floor(u) + floor(v) is even, tex2 otherwise.
+// 2D checkerboard (pbrt-v4 "checkerboard", dimension 2, without its filtering): with
+// (s, t) = mapping(uv), tex1 where floor(s) + floor(t) is even, tex2 otherwise.
 class CheckerboardTexture final : public Texture {
  public:
   CheckerboardTexture(TexturePtr tex1, TexturePtr tex2, UvMapping mapping)

@@ -1,0 +1,95 @@
+#include "experiment/comparison.h"
+
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <memory>
+
+#include "image/metrics.h"
+#include "integrators/registry.h"
+#include "render/film.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
+
+namespace caustica {
+
+ErrorMetrics compute_errors(const Image& image, const Image& reference) {
+  ErrorMetrics e;
+  e.mse = mse(image, reference);
+  e.rmse = std::sqrt(e.mse);
+  e.rel_mse = rel_mse(image, reference, 0.01);
+  e.rel_mse_trimmed = rel_mse_trimmed(image, reference, 0.001, 0.01);
+  e.ssim = ssim(image, reference);
+  return e;
+}
+
+nlohmann::json to_json(const ErrorMetrics& e) {
+  return {{"mse", e.mse}, {"rmse", e.rmse}, {"relmse", e.rel_mse}, {"relmse_trimmed", e.rel_mse_trimmed}, {"ssim", e.ssim}};
+}
+
+ComparisonResult run_comparison(const Scene& scene, const Image& reference, const ComparisonConfig& config,
+                                const std::function<void(double, const std::string&)>& progress) {
+  if (reference.width() != scene.camera().width() || reference.height() != scene.camera().height())
+    throw std::runtime_error("reference is " + std::to_string(reference.width()) + "x" +
+                             std::to_string(reference.height()) + " but the scene renders " +
+                             std::to_string(scene.camera().width()) + "x" + std::to_string(scene.camera().height()));
+  std::unique_ptr<tbb::global_control> limit;
+  if (config.threads > 0)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(config.threads));
+
+  ComparisonResult result;
+  result.scene = scene.name();
+  result.config = config;
+  const double total = config.seconds * double(config.integrators.size());
+  for (size_t k = 0; k < config.integrators.size(); ++k) {
+    const std::string& name = config.integrators[k];
+    auto integrator = make_integrator(name, config.settings);
+    if (!integrator) throw std::invalid_argument("unknown integrator '" + name + "'");
+    IntegratorRun run;
+    run.integrator = name;
+    double next_snapshot = config.first_snapshot;
+    RenderCallbacks cb;
+    cb.quiet = true;
+    cb.on_iteration = [&](const Film& film, uint32_t iterations, double seconds) {
+      if (seconds >= next_snapshot) {
+        run.snapshots.push_back({seconds, iterations, compute_errors(film.image(), reference)});
+        while (next_snapshot <= seconds) next_snapshot *= 2;
+      }
+      if (progress) progress((double(k) * config.seconds + std::min(seconds, config.seconds)) / total, name);
+      return true;
+    };
+    RenderBudget budget;
+    budget.seconds = config.seconds;
+    const RenderResult r = render(scene, *integrator, budget, cb);
+    run.image = r.image;
+    run.seconds = r.seconds;
+    run.iterations = r.iterations;
+    run.rays = r.rays;
+    run.nonfinite = r.nonfinite;
+    run.snapshots.push_back({r.seconds, r.iterations, compute_errors(r.image, reference)});
+    integrator->report(run.integrator_stats);
+    result.runs.push_back(std::move(run));
+  }
+  if (progress) progress(1.0, "done");
+  return result;
+}
+
+double time_to_rel_mse(const IntegratorRun& run, double target) {
+  const auto& s = run.snapshots;
+  if (s.empty() || !(target > 0)) return -1;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i].errors.rel_mse <= target) {
+      if (i == 0) return s[0].seconds * s[0].errors.rel_mse / target;  // ~1/t before the first point
+      // Log-log interpolation between snapshots i-1 and i.
+      const double t0 = std::log(s[i - 1].seconds), t1 = std::log(s[i].seconds);
+      const double e0 = std::log(s[i - 1].errors.rel_mse), e1 = std::log(s[i].errors.rel_mse);
+      if (e1 == e0) return s[i].seconds;
+      const double f = (std::log(target) - e0) / (e1 - e0);
+      return std::exp(t0 + f * (t1 - t0));
+    }
+  }
+  const Snapshot& last = s.back();
+  return last.errors.rel_mse > 0 ? last.seconds * last.errors.rel_mse / target : -1;
+}
+
+}  // namespace caustica

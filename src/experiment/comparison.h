@@ -1,0 +1,66 @@
+// Equal-time comparisons: every integrator renders the same scene for the same wall time and
+// threads; the image is compared against a reference at log-spaced times (1, 2, 4, ... s)
+// and at the end. Time spent computing errors is excluded from render time.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "image/image.h"
+#include "integrators/integrator.h"
+
+namespace caustica {
+
+class Scene;
+
+struct ErrorMetrics {
+  double mse = 0, rmse = 0, rel_mse = 0, rel_mse_trimmed = 0, ssim = 0;
+};
+ErrorMetrics compute_errors(const Image& image, const Image& reference);
+nlohmann::json to_json(const ErrorMetrics& e);
+
+struct Snapshot {
+  double seconds = 0;
+  uint32_t iterations = 0;
+  ErrorMetrics errors;
+};
+
+struct IntegratorRun {
+  std::string integrator;
+  std::vector<Snapshot> snapshots;  // log-spaced, the last one at the end of the run
+  Image image;
+  double seconds = 0;
+  uint32_t iterations = 0;
+  uint64_t rays = 0;
+  uint64_t nonfinite = 0;
+  nlohmann::json integrator_stats;
+};
+
+struct ComparisonConfig {
+  std::vector<std::string> integrators;
+  double seconds = 30;
+  int threads = 0;  // 0 = all cores
+  IntegratorSettings settings;
+  double first_snapshot = 1.0;  // seconds; then doubling
+};
+
+struct ComparisonResult {
+  std::string scene;
+  ComparisonConfig config;
+  std::vector<IntegratorRun> runs;
+  std::string reference_description;
+};
+
+// progress(fraction, label) is called as the comparison advances (across all integrators).
+ComparisonResult run_comparison(const Scene& scene, const Image& reference, const ComparisonConfig& config,
+                                const std::function<void(double, const std::string&)>& progress = {});
+
+// Time integrator `run` would need to reach `target` relMSE, read off its convergence curve
+// (log-log interpolation between snapshots; beyond the last snapshot, Monte Carlo's
+// relMSE ~ 1/t is assumed). Returns a negative number if the curve is unusable.
+double time_to_rel_mse(const IntegratorRun& run, double target);
+
+}  // namespace caustica

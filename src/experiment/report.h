@@ -1,0 +1,26 @@
+// Writes a comparison to a directory: per-integrator EXR and PNG, false-colour error images,
+// results.json, results.csv, convergence.svg and index.html — a page that opens from disk with
+// no network (all script and style inline; images are files beside it).
+#pragma once
+
+#include <string>
+
+#include "experiment/comparison.h"
+
+namespace caustica {
+
+struct ReportOptions {
+  float exposure = 0;  // PNG exposure in stops
+};
+
+void write_comparison_report(const ComparisonResult& result, const Image& reference, const std::string& dir,
+                             const ReportOptions& options = {});
+
+// The convergence plot (relMSE against time, log-log, one line per integrator) as SVG.
+std::string convergence_svg(const ComparisonResult& result, int width = 720, int height = 440);
+
+// Summary rows: final errors and speed-up relative to `pt` in time-to-equal-relMSE
+// (speedup = time pt needs to reach this integrator's final relMSE / this run's time).
+nlohmann::json comparison_summary(const ComparisonResult& result);
+
+}  // namespace caustica

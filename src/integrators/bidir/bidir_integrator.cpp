@@ -1,0 +1,606 @@
+#include "integrators/bidir/bidir_integrator.h"
+
+#include <tbb/parallel_for.h>
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "core/arena.h"
+#include "core/rng.h"
+#include "image/image_io.h"
+#include "integrators/bidir/hash_grid.h"
+#include "integrators/bidir/light_vertex.h"
+#include "integrators/bidir/techniques.h"
+#include "lights/light.h"
+#include "lights/light_sampler.h"
+#include "materials/material.h"
+#include "render/film.h"
+#include "render/tiles.h"
+#include "scene/scene.h"
+
+namespace caustica {
+
+namespace {
+
+using bidir::HashGrid;
+using bidir::LightVertex;
+using bidir::LightVertexData;
+using bidir::MisRules;
+using bidir::MisSums;
+using bidir::PositionCodec;
+
+constexpr uint32_t kChunkPaths = 1024;  // light paths per chunk: fixed, independent of threads
+constexpr float kDefaultRadiusFactor = 0.003f;
+
+// Which techniques take part (tech. rep. section 6, SmallVCM's switches).
+struct Techniques {
+  bool light_to_camera = false;   // t = 1 splats
+  bool connect = false;           // NEE, emitter hits and connections, MIS-weighted
+  bool merge = false;             // vertex merging
+  bool camera_stops = false;      // camera subpaths end at their first non-delta vertex
+  bool unweighted = false;        // single-technique estimators (lt, ppm): all weights 1
+};
+
+Techniques techniques_of(BidirAlgorithm a) {
+  Techniques t;
+  switch (a) {
+    case BidirAlgorithm::LightTracing:
+      t.light_to_camera = t.camera_stops = t.unweighted = true;
+      break;
+    case BidirAlgorithm::Bpt:
+      t.light_to_camera = t.connect = true;
+      break;
+    case BidirAlgorithm::Ppm:
+      t.merge = t.camera_stops = t.unweighted = true;
+      break;
+    case BidirAlgorithm::Bpm:
+      t.merge = true;
+      break;
+    case BidirAlgorithm::Vcm:
+      t.light_to_camera = t.connect = t.merge = true;
+      break;
+  }
+  return t;
+}
+
+const char* name_of(BidirAlgorithm a) {
+  switch (a) {
+    case BidirAlgorithm::LightTracing: return "lt";
+    case BidirAlgorithm::Bpt: return "bpt";
+    case BidirAlgorithm::Ppm: return "ppm";
+    case BidirAlgorithm::Bpm: return "bpm";
+    case BidirAlgorithm::Vcm: return "vcm";
+  }
+  return "?";
+}
+
+// One image per technique, allocated on first use. Key: (merge, s, t) with s light vertices
+// (the light point included) and t camera vertices (the lens included); a merge at a vertex
+// counts that vertex on both sides.
+class TechniqueImages {
+ public:
+  static constexpr int kMaxVertices = 64;
+  static uint32_t key(bool merge, int s, int t) {
+    return (merge ? kMaxVertices * kMaxVertices : 0) + uint32_t(std::min(s, kMaxVertices - 1)) * kMaxVertices +
+           uint32_t(std::min(t, kMaxVertices - 1));
+  }
+  void reset(int width, int height) {
+    width_ = width;
+    height_ = height;
+    for (auto& s : slots_) s.reset();
+    for (auto& p : pointers_) p.store(nullptr);
+  }
+  bool enabled() const { return width_ > 0; }
+  void add(uint32_t key, size_t pixel, Rgb value) {
+    Image* image = pointers_[key].load(std::memory_order_acquire);
+    if (!image) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!slots_[key]) {
+        slots_[key] = std::make_unique<Image>(width_, height_);
+        pointers_[key].store(slots_[key].get(), std::memory_order_release);
+      }
+      image = slots_[key].get();
+    }
+    (*image)[pixel] += value;
+  }
+  // Writes each technique averaged over `iterations`; returns the files written.
+  std::vector<std::string> write(const std::string& dir, uint32_t iterations) const {
+    std::filesystem::create_directories(dir);
+    std::vector<std::string> files;
+    const float scale = iterations > 0 ? 1.f / float(iterations) : 0.f;
+    for (uint32_t k = 0; k < slots_.size(); ++k) {
+      if (!slots_[k]) continue;
+      Image out = *slots_[k];
+      for (Rgb& p : out.pixels()) p *= scale;
+      const bool merge = k >= uint32_t(kMaxVertices * kMaxVertices);
+      const uint32_t rest = k % (kMaxVertices * kMaxVertices);
+      const std::string name = std::string(merge ? "merge_" : "connect_") + "s" + std::to_string(rest / kMaxVertices) +
+                               "_t" + std::to_string(rest % kMaxVertices) + ".exr";
+      write_exr(out, (std::filesystem::path(dir) / name).string());
+      files.push_back(name);
+    }
+    return files;
+  }
+
+ private:
+  int width_ = 0, height_ = 0;
+  std::mutex mutex_;
+  std::array<std::unique_ptr<Image>, 2 * kMaxVertices * kMaxVertices> slots_;
+  std::array<std::atomic<Image*>, 2 * kMaxVertices * kMaxVertices> pointers_{};
+};
+
+struct Splat {
+  uint32_t pixel;
+  uint32_t technique;
+  Rgb value;
+};
+
+// What one chunk of light paths leaves behind.
+struct LightChunk {
+  std::vector<LightVertex> vertices;
+  std::vector<uint32_t> path_ends;  // per path: vertices.size() after it
+  std::vector<Splat> splats;
+  uint64_t nonfinite = 0;
+};
+
+// Per-iteration constants.
+struct Iteration {
+  uint32_t index = 0;
+  float radius = 0;
+  MisRules rules{MisHeuristic::Balance, false, false, 1, 0};
+  float merge_normalization = 0;  // 1 / (N pi r^2)
+};
+
+// A value added to the pixel and, if technique images are kept, to its technique.
+struct PixelAccumulator {
+  Rgb sum;
+  TechniqueImages* techniques = nullptr;
+  size_t pixel = 0;
+  uint64_t nonfinite = 0;
+  void add(bool merge, int s, int t, Rgb value) {
+    if (!value.is_finite()) {
+      ++nonfinite;
+      return;
+    }
+    sum += value;
+    if (techniques) techniques->add(TechniqueImages::key(merge, s, t), pixel, value);
+  }
+};
+
+Ray ray_leaving_light(const LightLeSample& le, const Light& light) {
+  if (light.type() == LightType::Area) {
+    // The emission point lies on the light's surface: nudge it to the emitting side.
+    const Vec3 side = face_forward(le.n, le.dir);
+    const float eps = 1e-4f * std::max(1.f, max_component(abs(le.p)));
+    return {le.p + side * eps, le.dir, kInfinity};
+  }
+  return {le.p, le.dir, kInfinity};
+}
+
+class BidirIntegrator final : public Integrator {
+ public:
+  BidirIntegrator(BidirAlgorithm algorithm, const IntegratorSettings& settings)
+      : algorithm_(algorithm), tech_(techniques_of(algorithm)), settings_(settings) {
+    heuristic_ = settings.mis_from_user ? settings.mis : MisHeuristic::Balance;
+  }
+  const char* name() const override { return name_of(algorithm_); }
+
+  void prepare(const Scene& scene, Film& film) override {
+    Vec3 center;
+    float scene_radius;
+    scene.bounds().bounding_sphere(&center, &scene_radius);
+    base_radius_ = settings_.radius > 0 ? settings_.radius : kDefaultRadiusFactor * std::max(scene_radius, 1e-3f);
+    codec_ = PositionCodec(scene.bounds().lo, scene.bounds().hi);
+    light_paths_ = settings_.light_paths > 0 ? settings_.light_paths : film.pixel_count();
+    if (!settings_.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
+    const uint64_t chunks = (light_paths_ + kChunkPaths - 1) / kChunkPaths;
+    chunks_.resize(chunks);
+  }
+
+  void render_iteration(const Scene& scene, uint32_t iteration, Film& film) override {
+    const auto start = std::chrono::steady_clock::now();
+    Iteration it;
+    it.index = iteration;
+    // r_i = r_1 * i^((alpha - 1) / 2), i 1-based (Knaus & Zwicker 2011; Georgiev et al. 2012).
+    it.radius = std::max(base_radius_ * std::pow(float(iteration + 1), 0.5f * (settings_.radius_alpha - 1.f)), 1e-7f);
+    it.rules = MisRules(heuristic_, tech_.connect || tech_.light_to_camera, tech_.merge, float(light_paths_), it.radius);
+    it.merge_normalization = 1.f / (kPi * it.radius * it.radius * float(light_paths_));
+
+    trace_light_paths(scene, it, film);
+    if (tech_.merge) grid_.build(vertices_, codec_, it.radius);
+    trace_camera_paths(scene, it, film);
+
+    ++iterations_;
+    last_radius_ = it.radius;
+    vertices_total_ += vertices_.size();
+    seconds_total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
+  void finish(const Scene&, Film& film) override {
+    if (techniques_.enabled()) technique_files_ = techniques_.write(settings_.techniques_dir, film.iterations());
+  }
+
+  void report(nlohmann::json& stats) const override {
+    nlohmann::json b;
+    b["algorithm"] = name();
+    b["mis"] = heuristic_ == MisHeuristic::Power ? "power" : "balance";
+    b["light_paths_per_iteration"] = light_paths_;
+    b["light_vertices_per_iteration"] = iterations_ ? double(vertices_total_) / iterations_ : 0.0;
+    b["bytes_per_light_vertex"] = sizeof(LightVertex);
+    b["light_vertex_buffer_bytes"] = vertices_.capacity() * sizeof(LightVertex);
+    b["hash_grid_bytes"] = grid_.memory_bytes();
+    b["radius_initial"] = base_radius_;
+    b["radius_last"] = last_radius_;
+    b["radius_alpha"] = settings_.radius_alpha;
+    b["ms_per_iteration"] = iterations_ ? 1e3 * seconds_total_ / iterations_ : 0.0;
+    if (!technique_files_.empty()) b["technique_images"] = technique_files_;
+    stats["bidir"] = b;
+  }
+
+ private:
+  bool stores_vertices() const { return tech_.connect || tech_.merge; }
+
+  // ---- light subpaths -----------------------------------------------------------------------
+  void trace_light_paths(const Scene& scene, const Iteration& it, Film& film) {
+    tbb::parallel_for(size_t(0), chunks_.size(), [&](size_t c) {
+      thread_local ScratchArena arena;
+      LightChunk& chunk = chunks_[c];
+      chunk.vertices.clear();
+      chunk.path_ends.clear();
+      chunk.splats.clear();
+      chunk.nonfinite = 0;
+      const uint64_t first = c * kChunkPaths, last = std::min<uint64_t>(first + kChunkPaths, light_paths_);
+      for (uint64_t path = first; path < last; ++path) {
+        arena.reset();
+        trace_light_path(scene, it, path, chunk, arena);
+        chunk.path_ends.push_back(uint32_t(chunk.vertices.size()));
+      }
+    });
+
+    // Concatenate in chunk order: vertex i of path p is at path_begin_[p] + i.
+    size_t total = 0;
+    for (const LightChunk& c : chunks_) total += c.vertices.size();
+    vertices_.resize(total);
+    path_begin_.resize(light_paths_ + 1);
+    std::vector<size_t> chunk_offset(chunks_.size());
+    for (size_t c = 0, offset = 0; c < chunks_.size(); ++c) {
+      chunk_offset[c] = offset;
+      offset += chunks_[c].vertices.size();
+    }
+    tbb::parallel_for(size_t(0), chunks_.size(), [&](size_t c) {
+      const LightChunk& chunk = chunks_[c];
+      std::copy(chunk.vertices.begin(), chunk.vertices.end(), vertices_.begin() + chunk_offset[c]);
+      const uint64_t first = c * kChunkPaths;
+      for (size_t i = 0; i < chunk.path_ends.size(); ++i) {
+        path_begin_[first + i] = uint32_t(chunk_offset[c] + (i ? chunk.path_ends[i - 1] : 0));
+      }
+    });
+    path_begin_[light_paths_] = uint32_t(total);
+
+    if (!tech_.light_to_camera) return;
+    if (splat_image_.width() != film.width()) splat_image_ = Image(film.width(), film.height());
+    std::fill(splat_image_.pixels().begin(), splat_image_.pixels().end(), Rgb(0.f));
+    uint64_t nonfinite = 0;
+    for (const LightChunk& chunk : chunks_) {  // fixed order: deterministic sums
+      nonfinite += chunk.nonfinite;
+      for (const Splat& s : chunk.splats) {
+        splat_image_[s.pixel] += s.value;
+        if (techniques_.enabled()) techniques_.add(s.technique, s.pixel, s.value);
+      }
+    }
+    if (nonfinite) film.count_nonfinite(nonfinite);
+    film.add_image(splat_image_);
+  }
+
+  void trace_light_path(const Scene& scene, const Iteration& it, uint64_t path, LightChunk& chunk,
+                        ScratchArena& arena) const {
+    const LightSampler& sampler = scene.light_sampler();
+    if (sampler.empty()) return;
+    Pcg32 rng = Pcg32::for_sample(path, it.index, hash_combine(settings_.seed, 0x11947ull));
+    float pmf;
+    const Light* light = sampler.sample(rng.next_float(), &pmf);
+    const Vec2 u_pos = rng.next_2d(), u_dir = rng.next_2d();
+    if (!light || !(pmf > 0)) return;
+    const auto le = light->sample_le(u_pos, u_dir);
+    if (!le || !(le->pdf_pos > 0) || !(le->pdf_dir > 0) || le->radiance.is_black()) return;
+    const float emission_pdf = pmf * le->pdf_pos * le->pdf_dir;
+    Rgb beta = le->radiance * (le->cos_at_light / emission_pdf);
+    const float beta_start = beta.max_component();
+    const int max_depth = settings_.max_depth;
+
+    Ray ray = ray_leaving_light(*le, *light);
+    MisSums mis;
+    float segment = 0;  // distance since the previous real vertex (interfaces are skipped)
+    int depth = 0;
+    float eta_scale = 1;
+    for (;;) {
+      SurfaceInteraction si;
+      if (!scene.intersect(ray, &si)) break;
+      segment += si.t;
+      Bsdf bsdf;
+      if (si.material) bsdf = si.material->bsdf(si, arena);
+      if (!bsdf.valid()) {
+        ray = si.spawn_ray(ray.d);
+        continue;
+      }
+      ++depth;
+      if (depth == 1) {
+        mis = light_subpath_start(it.rules, *light, pmf, *le, si, segment);
+      } else {
+        it.rules.hit(mis, segment * segment, bidir::geometric_cos(si, si.wo));
+      }
+      segment = 0;
+      if (depth > max_depth) break;
+
+      if (!bsdf.is_delta()) {
+        if (stores_vertices()) {
+          chunk.vertices.push_back(
+              bidir::pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}, codec_));
+        }
+        if (tech_.light_to_camera) connect_to_camera(scene, it, si, bsdf, beta, mis, depth, rng, chunk);
+      }
+      if (depth + 1 > max_depth) break;
+
+      const float uc = rng.next_float();
+      const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Importance);
+      if (!bs) break;
+      const float pdf_fwd = bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Importance) : bs->pdf;
+      bidir::scatter_update(it.rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Importance, bs->is_specular(), pdf_fwd);
+      beta *= bs->f * (bsdf.abs_cos(bs->wi) / bs->pdf);
+      if (bs->is_transmission()) eta_scale *= sqr(bs->eta);
+      if (beta.is_black()) break;
+      ray = si.spawn_ray(bs->wi);
+      // Russian roulette on the throughput relative to the emitted one.
+      const float rr = beta.max_component() / beta_start;
+      if (rr < 1 && depth > 1) {
+        const float q = std::max(0.f, 1 - rr);
+        if (rng.next_float() < q) break;
+        beta = beta / (1 - q);
+      }
+    }
+    (void)eta_scale;
+  }
+
+  // t = 1: the light vertex seen through a lens point; splat recorded in the chunk.
+  void connect_to_camera(const Scene& scene, const Iteration& it, const SurfaceInteraction& si, const Bsdf& bsdf,
+                         Rgb beta, const MisSums& mis, int depth, Pcg32& rng, LightChunk& chunk) const {
+    const Camera& camera = scene.camera();
+    const auto cs = camera.sample_wi(si.p, rng.next_2d());
+    if (!cs || !(cs->importance > 0)) return;
+    const Rgb f = bsdf.f(si.wo, cs->wi, TransportMode::Importance) * bsdf.abs_cos(cs->wi);
+    if (f.is_black()) return;
+    // Pixel importance is pixel_count * We; each pixel is estimated by N light paths.
+    const float scale = cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(light_paths_));
+    const float w =
+        tech_.unweighted ? 1.f : bidir::weight_light_to_camera(it.rules, camera, si, bsdf, si.wo, mis, cs->p_lens);
+    const Rgb value = beta * f * (scale * w);
+    if (value.is_black()) return;
+    if (!value.is_finite()) {
+      ++chunk.nonfinite;
+      return;
+    }
+    if (scene.occluded(si.spawn_ray_to(cs->p_lens))) return;
+    const int x = std::min(int(cs->raster.x), camera.width() - 1), y = std::min(int(cs->raster.y), camera.height() - 1);
+    chunk.splats.push_back({uint32_t(y * camera.width() + x), TechniqueImages::key(false, depth + 1, 1), value});
+  }
+
+  // ---- camera subpaths ----------------------------------------------------------------------
+  void trace_camera_paths(const Scene& scene, const Iteration& it, Film& film) {
+    std::atomic<uint64_t> nonfinite{0};
+    parallel_for_tiles(film.width(), film.height(), [&](const Tile& tile, ScratchArena& arena) {
+      uint64_t bad = 0;
+      for (int y = tile.y0; y < tile.y1; ++y)
+        for (int x = tile.x0; x < tile.x1; ++x) {
+          arena.reset();
+          PixelAccumulator acc;
+          acc.pixel = size_t(y) * film.width() + x;
+          if (techniques_.enabled()) acc.techniques = &techniques_;
+          camera_path(scene, it, x, y, acc, arena);
+          film.add_sample(x, y, acc.sum);
+          bad += acc.nonfinite;
+        }
+      if (bad) nonfinite += bad;
+    });
+    if (nonfinite) film.count_nonfinite(nonfinite);
+  }
+
+  void camera_path(const Scene& scene, const Iteration& it, int x, int y, PixelAccumulator& acc,
+                   ScratchArena& arena) const {
+    const Camera& camera = scene.camera();
+    const LightSampler& lights = scene.light_sampler();
+    const uint64_t pixel = acc.pixel;
+    Pcg32 rng = Pcg32::for_sample(pixel, it.index, hash_combine(settings_.seed, 0xca3e7aull));
+    const Vec2 jitter = rng.next_2d();
+    const Vec2 lens = rng.next_2d();
+    Ray ray = camera.generate_ray({x + jitter.x, y + jitter.y}, lens);
+    const float pdf_camera = bidir::camera_pdf_w(camera, ray.d);
+    if (!(pdf_camera > 0)) return;
+    MisSums mis = it.rules.camera_start(pdf_camera);
+    const int max_depth = settings_.max_depth;
+    const uint64_t light_path = pixel % light_paths_;  // the light subpath this camera path connects to
+
+    Rgb beta(1.f);
+    Vec3 prev_p = ray.o;
+    int depth = 0;               // surface vertices so far
+    bool specular_path = true;   // every bounce so far was specular
+    float segment = 0;
+    float eta_scale = 1;
+    // Emitters: MIS-weighted when connections take part, else only via delta-only chains.
+    auto emitter_weight = [&](const Light& light, const SurfaceInteraction* hit, const MisSums& m) {
+      if (depth == 0) return 1.f;
+      if (!tech_.connect) return specular_path ? 1.f : 0.f;
+      return bidir::weight_emitter_hit(it.rules, light, lights.pmf(&light), prev_p, ray.d, hit, m);
+    };
+
+    for (;;) {
+      SurfaceInteraction si;
+      if (!scene.intersect(ray, &si)) {
+        for (const Light* light : scene.infinite_lights()) {
+          const Rgb Le = light->radiance_escaped(ray.d);
+          if (Le.is_black()) continue;
+          const float w = emitter_weight(*light, nullptr, mis);
+          if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w);
+        }
+        break;
+      }
+      segment += si.t;
+      Bsdf bsdf;
+      if (si.material) bsdf = si.material->bsdf(si, arena);
+      MisSums at_hit = mis;
+      it.rules.hit(at_hit, segment * segment, bidir::geometric_cos(si, si.wo));
+
+      if (si.area_light) {
+        const Rgb Le = si.area_light->radiance(si.p, si.ng, si.uv, si.wo);
+        if (!Le.is_black()) {
+          const float w = emitter_weight(*si.area_light, &si, at_hit);
+          if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w);
+        }
+      }
+      if (!bsdf.valid()) {
+        ray = si.spawn_ray(ray.d);
+        continue;
+      }
+      ++depth;
+      mis = at_hit;
+      segment = 0;
+      if (depth > max_depth) break;
+
+      const bool delta = bsdf.is_delta();
+      if (!delta) {
+        if (tech_.connect) {
+          next_event(scene, it, si, bsdf, beta, mis, depth, rng, acc);
+          connect_to_light_path(scene, it, si, bsdf, beta, mis, depth, light_path, arena, acc);
+        }
+        if (tech_.merge) merge(it, si, bsdf, beta, mis, depth, acc);
+      }
+
+      const float uc = rng.next_float();
+      const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Radiance);
+      if (!bs) break;
+      // PPM / lt: the non-delta part of this vertex was estimated by merging (or belongs to light
+      // tracing); only its delta lobes carry the camera path on.
+      if (tech_.camera_stops && !delta && !bs->is_specular()) break;
+      const float pdf_fwd = bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Radiance) : bs->pdf;
+      bidir::scatter_update(it.rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Radiance, bs->is_specular(), pdf_fwd);
+      beta *= bs->f * (bsdf.abs_cos(bs->wi) / bs->pdf);
+      specular_path = specular_path && bs->is_specular();
+      if (bs->is_transmission()) eta_scale *= sqr(bs->eta);
+      if (beta.is_black()) break;
+      prev_p = si.p;
+      ray = si.spawn_ray(bs->wi);
+      // Russian roulette as pt: throughput with the radiance scaling of refraction removed.
+      const float rr = (beta * eta_scale).max_component();
+      if (rr < 1 && depth > 1) {
+        const float q = std::max(0.f, 1 - rr);
+        if (rng.next_float() < q) break;
+        beta = beta / (1 - q);
+      }
+    }
+  }
+
+  void next_event(const Scene& scene, const Iteration& it, const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
+                  const MisSums& mis, int depth, Pcg32& rng, PixelAccumulator& acc) const {
+    const LightSampler& lights = scene.light_sampler();
+    float pmf;
+    const Light* light = lights.sample(rng.next_float(), &pmf);
+    const Vec2 u = rng.next_2d();
+    if (!light || !(pmf > 0)) return;
+    const auto ls = light->sample_li(si.p, u);
+    if (!ls || !(ls->pdf_w > 0) || ls->radiance.is_black()) return;
+    const Rgb f = bsdf.f(si.wo, ls->wi, TransportMode::Radiance) * bsdf.abs_cos(ls->wi);
+    if (f.is_black()) return;
+    const float w = bidir::weight_next_event(it.rules, *light, pmf, *ls, si, bsdf, mis);
+    const Rgb value = beta * f * ls->radiance * (w / (pmf * ls->pdf_w));
+    if (value.is_black()) return;
+    const Ray shadow = std::isinf(ls->distance) ? si.spawn_ray(ls->wi) : si.spawn_ray_to(ls->p_light);
+    if (scene.occluded(shadow)) return;
+    acc.add(false, 1, depth + 1, value);
+  }
+
+  void connect_to_light_path(const Scene& scene, const Iteration& it, const SurfaceInteraction& si, const Bsdf& bsdf,
+                             Rgb beta, const MisSums& mis, int depth, uint64_t light_path, ScratchArena& arena,
+                             PixelAccumulator& acc) const {
+    for (uint32_t i = path_begin_[light_path]; i < path_begin_[light_path + 1]; ++i) {
+      const LightVertex& stored = vertices_[i];
+      // Stored in increasing depth: once too long, all the rest are too.
+      if (bidir::light_vertex_depth(stored) + depth > settings_.max_depth) break;
+      const LightVertexData v = bidir::unpack_light_vertex(stored, codec_);
+      const SurfaceInteraction light_si = scene.interaction_at(v.primitive, v.p, v.wo);
+      const Bsdf light_bsdf = light_si.material->bsdf(light_si, arena);
+      if (!light_bsdf.valid()) continue;
+      const Vec3 d = light_si.p - si.p;
+      const float dist2 = length_squared(d);
+      if (!(dist2 > 0)) continue;
+      const Vec3 dir = d / std::sqrt(dist2);
+      const Rgb f_camera = bsdf.f(si.wo, dir, TransportMode::Radiance) * bsdf.abs_cos(dir);
+      if (f_camera.is_black()) continue;
+      const Rgb f_light = light_bsdf.f(v.wo, -dir, TransportMode::Importance) * light_bsdf.abs_cos(dir);
+      if (f_light.is_black()) continue;
+      const float w = bidir::weight_connection(it.rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf, mis);
+      const Rgb value = beta * v.throughput * f_camera * f_light * (w / dist2);
+      if (value.is_black()) continue;
+      if (scene.occluded(spawn_ray_between(si, light_si))) continue;
+      acc.add(false, v.depth + 1, depth + 1, value);
+    }
+  }
+
+  void merge(const Iteration& it, const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta, const MisSums& mis,
+             int depth, PixelAccumulator& acc) const {
+    const int max_depth = settings_.max_depth;
+    grid_.for_each_near(si.p, vertices_, codec_, [&](uint32_t index, Vec3) {
+      const LightVertex& stored = vertices_[index];
+      const int light_depth = bidir::light_vertex_depth(stored);
+      if (light_depth + depth - 1 > max_depth) return;
+      const LightVertexData v = bidir::unpack_light_vertex(stored, codec_);
+      const Rgb f = bsdf.f(si.wo, v.wo, TransportMode::Radiance);
+      if (f.is_black()) return;
+      const float w = tech_.unweighted ? 1.f : bidir::weight_merge(it.rules, v.wo, v.mis, si, bsdf, mis);
+      acc.add(true, light_depth + 1, depth + 1, beta * f * v.throughput * (w * it.merge_normalization));
+    });
+  }
+
+  BidirAlgorithm algorithm_;
+  Techniques tech_;
+  IntegratorSettings settings_;
+  MisHeuristic heuristic_;
+  float base_radius_ = 0, last_radius_ = 0;
+  uint64_t light_paths_ = 0;
+  PositionCodec codec_;
+
+  // Per-iteration buffers, reused.
+  std::vector<LightChunk> chunks_;
+  std::vector<LightVertex> vertices_;
+  std::vector<uint32_t> path_begin_;
+  HashGrid grid_;
+  Image splat_image_;
+  TechniqueImages techniques_;
+
+  // Statistics.
+  uint32_t iterations_ = 0;
+  uint64_t vertices_total_ = 0;
+  double seconds_total_ = 0;
+  std::vector<std::string> technique_files_;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_bidir_integrator(BidirAlgorithm algorithm, const IntegratorSettings& settings) {
+  return std::make_unique<BidirIntegrator>(algorithm, settings);
+}
+
+std::unique_ptr<Integrator> make_bidir_integrator(const std::string& name, const IntegratorSettings& settings) {
+  if (name == "lt") return make_bidir_integrator(BidirAlgorithm::LightTracing, settings);
+  if (name == "bpt") return make_bidir_integrator(BidirAlgorithm::Bpt, settings);
+  if (name == "ppm") return make_bidir_integrator(BidirAlgorithm::Ppm, settings);
+  if (name == "bpm") return make_bidir_integrator(BidirAlgorithm::Bpm, settings);
+  if (name == "vcm") return make_bidir_integrator(BidirAlgorithm::Vcm, settings);
+  return nullptr;
+}
+
+}  // namespace caustica

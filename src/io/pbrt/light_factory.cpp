@@ -1,0 +1,111 @@
+#include "io/pbrt/light_factory.h"
+
+#include <cmath>
+
+#include "lights/lights.h"
+
+namespace caustica::pbrt {
+
+namespace {
+
+// The emitted RGB of a light's spectrum parameter, default the illuminant (white), times
+// "scale".
+Rgb emission(const ParamList& params, const char* name, LoaderContext& ctx) {
+  const Param* p = params.find(name, {ParamType::Rgb, ParamType::Spectrum, ParamType::Blackbody});
+  const Rgb rgb = p ? spectrum_param_rgb(*p, SpectrumKind::Illuminant, ctx) : Rgb(1.f);
+  return rgb * params.get_float("scale", 1);
+}
+
+bool finite_vec(Vec3 v) { return is_finite(v); }
+
+}  // namespace
+
+AreaLightDesc make_area_light(const std::string& type, const ParamList& params, const SourceLocation& where,
+                              LoaderContext& ctx) {
+  if (type != "diffuse") throw SceneLoadError(where, "unknown area light type \"" + type + "\" (expected \"diffuse\")");
+  AreaLightDesc a;
+  a.where = where;
+  if (const Param* fp = params.find("filename")) {
+    ctx.warnings.warn(fp->where, "image-textured area lights are not supported; using \"L\"", "area light filename");
+  }
+  a.radiance = emission(params, "L", ctx);
+  a.two_sided = params.get_bool("twosided", false);
+  a.power = params.get_float("power", -1);
+  params.report_unused(ctx.warnings, "AreaLightSource \"diffuse\"");
+  return a;
+}
+
+void add_light_source(const std::string& type, const ParamList& params, const SourceLocation& where,
+                      const Transform& light_to_world, MaterialFactory& images, SceneBuilder& builder, LoaderContext& ctx) {
+  const std::string context = "LightSource \"" + type + "\"";
+  LightPtr light;
+  if (type == "point") {
+    Rgb I = emission(params, "I", ctx);
+    const float power = params.get_float("power", -1);
+    if (power > 0) I = I * (power / (4 * kPi));  // pbrt-v4: k_e = 4 pi
+    const Vec3 from = light_to_world.point(params.get_point3("from", {0, 0, 0}));
+    if (!finite_vec(from)) throw SceneLoadError(where, "point light position is not finite");
+    light = make_point_light(from, I);
+  } else if (type == "spot") {
+    Rgb I = emission(params, "I", ctx);
+    const float cone = params.get_float("coneangle", 30), delta = params.get_float("conedeltaangle", 5);
+    const Vec3 from = params.get_point3("from", {0, 0, 0}), to = params.get_point3("to", {0, 0, 1});
+    if (from == to) throw SceneLoadError(where, "spot: \"from\" and \"to\" are the same point");
+    const float power = params.get_float("power", -1);
+    if (power > 0) {
+      // pbrt-v4 SpotLight::Create: the power of the smoothstep cone.
+      const float cos_end = std::cos(radians(cone)), cos_start = std::cos(radians(cone - delta));
+      const float k_e = 2 * kPi * ((1 - cos_start) + (cos_start - cos_end) / 2);
+      if (k_e > 0) I = I * (power / k_e);
+    }
+    const Vec3 p = light_to_world.point(from), dir = light_to_world.vector(to - from);
+    if (!finite_vec(p) || !(length(dir) > 0) || !finite_vec(dir)) throw SceneLoadError(where, "spot light transform is degenerate");
+    light = make_spot_light(p, normalize(dir), I, cone, delta);
+  } else if (type == "distant") {
+    Rgb L = emission(params, "L", ctx);
+    const Vec3 from = params.get_point3("from", {0, 0, 0}), to = params.get_point3("to", {0, 0, 1});
+    if (from == to) throw SceneLoadError(where, "distant: \"from\" and \"to\" are the same point");
+    const float illuminance = params.get_float("illuminance", -1);
+    if (illuminance > 0) L = L * illuminance;
+    const Vec3 dir = light_to_world.vector(to - from);
+    if (!(length(dir) > 0) || !finite_vec(dir)) throw SceneLoadError(where, "distant light transform is degenerate");
+    light = make_distant_light(normalize(dir), L);
+  } else if (type == "infinite") {
+    const Param* lp = params.find("L");
+    const Param* fp = params.find("filename", {ParamType::String});
+    if (lp && fp) throw SceneLoadError(where, "infinite: \"L\" and \"filename\" cannot both be given");
+    if (params.find("portal"))
+      ctx.warnings.warn(params.find("portal")->where, "infinite light portals are not supported; ignored", "portal");
+    if (fp) {
+      const float scale = params.get_float("scale", 1);
+      if (params.find("illuminance"))
+        ctx.warnings.warn(params.find("illuminance")->where,
+                          "\"illuminance\" is not supported for image infinite lights; ignored", "image illuminance");
+      const std::string path = ctx.resolve(params.get_string("filename", ""), fp->where);
+      std::shared_ptr<const Image> image = images.load_image(path, false, *fp);
+      EnvironmentMapping mapping = EnvironmentMapping::EqualAreaOctahedral;
+      if (image->width() != image->height()) {
+        ctx.warnings.warn(fp->where, "environment map \"" + fp->strings[0] + "\" is " + std::to_string(image->width()) + "x" +
+                                         std::to_string(image->height()) +
+                                         ", not square: reading it as lat-long (pbrt-v4 expects an equal-area octahedral map)");
+        mapping = EnvironmentMapping::LatLong;
+      }
+      light = make_image_environment(image, mapping, light_to_world, Rgb(scale));
+    } else {
+      Rgb L = emission(params, "L", ctx);
+      const float illuminance = params.get_float("illuminance", -1);
+      if (illuminance > 0) L = L * (illuminance / kPi);  // a uniform sky of radiance 1 gives E = pi
+      light = make_uniform_environment(L);
+    }
+  } else if (type == "goniometric" || type == "projection") {
+    ctx.warnings.warn(where, "light \"" + type + "\" is not supported; skipped", "light " + type);
+    for (const Param& p : params.all()) p.used = true;
+    return;
+  } else {
+    throw SceneLoadError(where, "unknown light type \"" + type + "\" (expected point, spot, distant, infinite, goniometric or projection)");
+  }
+  params.report_unused(ctx.warnings, context);
+  builder.add_light(std::move(light));
+}
+
+}  // namespace caustica::pbrt

@@ -1,0 +1,144 @@
+#include <gtest/gtest.h>
+
+#include "core/distribution.h"
+#include "core/frame.h"
+#include "core/rng.h"
+#include "core/transform.h"
+#include "core/warp.h"
+
+using namespace caustica;
+
+TEST(Pcg32, SameKeyGivesSameStreamDifferentKeysDiffer) {
+  Pcg32 a = Pcg32::for_sample(5, 3, 1), b = Pcg32::for_sample(5, 3, 1), c = Pcg32::for_sample(6, 3, 1);
+  int same_as_c = 0;
+  for (int i = 0; i < 100; ++i) {
+    const uint32_t va = a.next_u32();
+    EXPECT_EQ(va, b.next_u32());
+    same_as_c += va == c.next_u32();
+  }
+  EXPECT_LT(same_as_c, 3);
+}
+
+TEST(Pcg32, FloatsAreInUnitIntervalWithMeanHalf) {
+  Pcg32 r(1, 2);
+  double sum = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const float v = r.next_float();
+    ASSERT_GE(v, 0.f);
+    ASSERT_LT(v, 1.f);
+    sum += v;
+  }
+  EXPECT_NEAR(sum / 100000, 0.5, 0.005);
+}
+
+TEST(Frame, IsOrthonormalAndRoundTrips) {
+  Pcg32 r(3, 4);
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 n = sample_uniform_sphere(r.next_2d());
+    const Frame f = Frame::from_normal(n);
+    EXPECT_NEAR(dot(f.s, f.t), 0, 1e-5);
+    EXPECT_NEAR(dot(f.s, f.n), 0, 1e-5);
+    EXPECT_NEAR(length(f.s), 1, 1e-5);
+    EXPECT_NEAR(length(f.t), 1, 1e-5);
+    const Vec3 v = sample_uniform_sphere(r.next_2d());
+    const Vec3 back = f.to_world(f.to_local(v));
+    EXPECT_NEAR(distance(v, back), 0, 1e-5);
+    EXPECT_NEAR(f.to_local(n).z, 1, 1e-5);
+  }
+}
+
+TEST(Transform, InverseUndoesAndComposesLikeMatrices) {
+  const Transform t = Transform::translate({1, 2, 3}) * Transform::rotate(30, {1, 1, 0}) * Transform::scale({2, 3, 4});
+  const Vec3 p(0.3f, -0.7f, 2.f);
+  const Vec3 q = t.inverse().point(t.point(p));
+  EXPECT_NEAR(distance(p, q), 0, 1e-5);
+  EXPECT_FALSE(t.swaps_handedness());
+  EXPECT_TRUE(Transform::scale({-1, 1, 1}).swaps_handedness());
+  // Normals stay perpendicular to transformed tangent vectors.
+  const Vec3 n(0, 0, 1), tangent(1, 1, 0);
+  EXPECT_NEAR(dot(t.normal(n), t.vector(tangent)), 0, 1e-5);
+}
+
+TEST(Transform, LookAtIsLeftHandedAsPbrt) {
+  // pbrt-v4: camera looks down +z, +y up, +x = cross(up, dir).
+  const Transform w2c = Transform::look_at({0, 0, 0}, {0, 1, 0}, {0, 0, 1});
+  const Vec3 forward = w2c.point({0, 5, 0});
+  EXPECT_NEAR(forward.z, 5, 1e-5);
+  const Vec3 up = w2c.point({0, 0, 2});
+  EXPECT_NEAR(up.y, 2, 1e-5);
+  const Vec3 x = w2c.point({1, 0, 0});  // cross(z, y) = -x: world +x is camera -x
+  EXPECT_NEAR(x.x, -1, 1e-5);
+}
+
+TEST(Distribution1D, DiscreteSamplingFollowsWeights) {
+  Distribution1D d({1, 0, 3, 4});
+  EXPECT_FLOAT_EQ(d.pmf(0), 1.f / 8);
+  EXPECT_FLOAT_EQ(d.pmf(1), 0.f);
+  EXPECT_FLOAT_EQ(d.pmf(3), 0.5f);
+  int counts[4] = {};
+  Pcg32 r(9, 9);
+  for (int i = 0; i < 80000; ++i) {
+    float pmf;
+    const size_t k = d.sample_discrete(r.next_float(), &pmf);
+    EXPECT_FLOAT_EQ(pmf, d.pmf(k));
+    counts[k]++;
+  }
+  EXPECT_EQ(counts[1], 0);
+  EXPECT_NEAR(counts[0] / 80000.0, 0.125, 0.006);
+  EXPECT_NEAR(counts[3] / 80000.0, 0.5, 0.01);
+}
+
+TEST(Distribution2D, PdfMatchesSampleAndIntegratesToOne) {
+  std::vector<float> v = {1, 2, 0, 4, 1, 1, 8, 0, 3, 3, 1, 2};
+  Distribution2D d(v, 4, 3);
+  Pcg32 r(2, 5);
+  for (int i = 0; i < 1000; ++i) {
+    float pdf;
+    const Vec2 p = d.sample(r.next_2d(), &pdf);
+    EXPECT_NEAR(pdf, d.pdf(p), 1e-4f * pdf);
+    EXPECT_GT(pdf, 0);
+  }
+  double integral = 0;
+  for (int y = 0; y < 300; ++y)
+    for (int x = 0; x < 400; ++x) integral += d.pdf({(x + 0.5f) / 400, (y + 0.5f) / 300});
+  EXPECT_NEAR(integral / (300 * 400), 1.0, 1e-3);
+}
+
+TEST(Warp, CosineHemisphereMatchesItsPdf) {
+  Pcg32 r(4, 4);
+  // Mean of cos over the cosine distribution is 2/3.
+  double sum = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const Vec3 w = sample_cosine_hemisphere(r.next_2d());
+    ASSERT_NEAR(length(w), 1, 1e-4);
+    ASSERT_GE(w.z, 0);
+    sum += w.z;
+  }
+  EXPECT_NEAR(sum / 100000, 2.0 / 3.0, 0.004);
+}
+
+TEST(Warp, ConeSamplesStayInsideTheCone) {
+  Pcg32 r(4, 5);
+  const float cos_max = 0.9f;
+  for (int i = 0; i < 10000; ++i) {
+    const Vec3 w = sample_uniform_cone(r.next_2d(), cos_max);
+    ASSERT_GE(w.z, cos_max - 1e-5f);
+    ASSERT_NEAR(length(w), 1, 1e-4);
+  }
+}
+
+TEST(Warp, TriangleSamplesAreUniform) {
+  Pcg32 r(5, 5);
+  // The mean of uniform barycentrics is (1/3, 1/3).
+  double b0 = 0, b1 = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const Vec2 b = sample_uniform_triangle(r.next_2d());
+    ASSERT_GE(b.x, 0);
+    ASSERT_GE(b.y, 0);
+    ASSERT_LE(b.x + b.y, 1.f + 1e-6f);
+    b0 += b.x;
+    b1 += b.y;
+  }
+  EXPECT_NEAR(b0 / 100000, 1.0 / 3, 0.003);
+  EXPECT_NEAR(b1 / 100000, 1.0 / 3, 0.003);
+}

@@ -32,7 +32,7 @@ constexpr TransportMode kModes[] = {kRadiance, kImportance};
 const Frame kTilted(Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 0, 0));
 
 // Number of chi-square tests in this file, for the Sidak-corrected significance.
-constexpr int kChi2Tests = 74;  // 8 diffuse + 8 diffuse transmission + 30 conductor + 28 dielectric
+constexpr int kChi2Tests = 76;  // 8 diffuse + 8 diffuse transmission + 32 conductor + 28 dielectric
 const double kSignificance = 1 - std::pow(1 - 0.01, 1.0 / kChi2Tests);
 
 TexturePtr constant(float v) { return make_constant_texture(Rgb(v)); }
@@ -262,6 +262,9 @@ TEST(Conductor, RoughSamplingMatchesPdf) {
         expect_chi2(s.bsdf, s.dir(theta), mode);
       }
   }
+  // Seen from below (BxDFs are two-sided in the local frame).
+  Surface s(rough_conductor_gold(0.2f, 0.2f));
+  for (auto mode : kModes) expect_chi2(s.bsdf, s.dir(130), mode);
 }
 
 TEST(Conductor, ReflectionIsReciprocal) {

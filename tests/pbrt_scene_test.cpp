@@ -11,6 +11,7 @@
 #include "lights/light.h"
 #include "pbrt_test_util.h"
 #include "scene/interaction.h"
+#include "test_scenes.h"
 
 namespace caustica {
 namespace {
@@ -302,6 +303,22 @@ TEST(PbrtSharedScenes, EveryThirdPartySceneLoads) {
     ++count;
   }
   EXPECT_EQ(count, 7);
+}
+
+// One sample per pixel with pt and a short path: every own scene renders to a finite,
+// lit image (the loader produced something an integrator can use).
+TEST(PbrtSharedScenes, OwnScenesRenderWithPt) {
+  for (const char* name : {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic", "mis-plates"}) {
+    SCOPED_TRACE(name);
+    auto scene = load_pbrt(shared(std::string(name) + ".pbrt"), test::capture_warning);
+    IntegratorSettings settings;
+    settings.max_depth = 3;
+    const RenderResult r = test::render_with(*scene, "pt", 1, settings);
+    EXPECT_EQ(r.nonfinite, 0u);
+    const Rgb mean = r.image.average();
+    EXPECT_TRUE(mean.is_finite());
+    EXPECT_GT(mean.average(), 0.f);
+  }
 }
 
 TEST(PbrtSharedScenes, MaterialTestballEnvironmentIsOrientedAndSquare) {

@@ -12,6 +12,8 @@ using Runner = std::function<int()>;
 
 Runner add_render_command(CLI::App& app);
 Runner add_scenes_command(CLI::App& app);
+Runner add_reference_command(CLI::App& app);
+Runner add_compare_command(CLI::App& app);
 
 // Parses a name against a list; on failure prints "unknown <what> 'x'; valid: a, b" and
 // returns false.

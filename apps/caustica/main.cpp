@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
     runners[app.get_subcommands({})[before]] = std::move(r);
   };
   add(caustica::cli::add_render_command);
+  add(caustica::cli::add_reference_command);
+  add(caustica::cli::add_compare_command);
   add(caustica::cli::add_scenes_command);
   try {
     app.parse(argc, argv);

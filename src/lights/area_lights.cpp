@@ -22,7 +22,8 @@ Vec3 sample_diffuse_emission(Vec3 n_emit, bool two_sided, Vec2 u, float* pdf_dir
   Vec3 w;
   if (two_sided) {
     const bool front = u.x < 0.5f;
-    u.x = front ? std::min(u.x * 2, kOneMinusEpsilon) : std::min((u.x - 0.5f) * 2, kOneMinusEpsilon);
+    u.x =
+        front ? std::min(u.x * 2, kOneMinusEpsilon) : std::min((u.x - 0.5f) * 2, kOneMinusEpsilon);
     w = sample_cosine_hemisphere(u);
     if (!front) w.z = -w.z;
     *pdf_dir = cosine_hemisphere_pdf(std::abs(w.z)) * 0.5f;
@@ -127,7 +128,10 @@ class TriangleAreaLight final : public Light {
 class SphereAreaLight final : public Light {
  public:
   SphereAreaLight(const Sphere& sphere, Rgb radiance, bool two_sided)
-      : c_(sphere.center), r_(sphere.radius), reverse_(sphere.reverse_orientation), L_(radiance),
+      : c_(sphere.center),
+        r_(sphere.radius),
+        reverse_(sphere.reverse_orientation),
+        L_(radiance),
         two_sided_(two_sided) {
     area_ = 4 * kPi * r_ * r_;
     inv_area_ = area_ > 0 ? 1.f / area_ : 0.f;
@@ -196,7 +200,8 @@ class SphereAreaLight final : public Light {
     const Vec3 n = emit_normal(p_light);
     if (!emits_toward(n, -wi)) return 0.f;
     const float dc2 = distance_squared(ref, c_);
-    if (use_area_sampling(dc2)) return area_to_solid_angle(inv_area_, distance_squared(ref, p_light), abs_dot(n, wi));
+    if (use_area_sampling(dc2))
+      return area_to_solid_angle(inv_area_, distance_squared(ref, p_light), abs_dot(n, wi));
     return cone_from(dc2).pdf;
   }
 
@@ -231,7 +236,9 @@ class SphereAreaLight final : public Light {
   // gets the same effect by offsetting the reference point along its normal first. Cone
   // sampling from there would collapse onto ref's own neighbourhood. Area sampling from a
   // point just outside stays unbiased (the far side is then occluded by the near side).
-  bool treat_as_inside(Vec3 ref) const { return distance_squared(ref, c_) <= r_ * r_ * (1 + 1e-4f); }
+  bool treat_as_inside(Vec3 ref) const {
+    return distance_squared(ref, c_) <= r_ * r_ * (1 + 1e-4f);
+  }
 
   struct Cone {
     float sin2_max, sin_max, cos_max, pdf;
@@ -242,7 +249,9 @@ class SphereAreaLight final : public Light {
   // surface degenerates to a hemisphere whose "nearest points" collapse onto the point itself;
   // pbrt-v4 avoids it by offsetting the reference point, we by a relative tolerance. Shared by
   // sample_li and pdf_li so both always take the same branch.
-  bool use_area_sampling(float dist_to_center2) const { return dist_to_center2 <= r_ * r_ * (1.f + 1e-4f); }
+  bool use_area_sampling(float dist_to_center2) const {
+    return dist_to_center2 <= r_ * r_ * (1.f + 1e-4f);
+  }
   // Shared by sample_li and pdf_li so that both report bit-identical densities.
   Cone cone_from(float dist_to_center2) const {
     Cone c;
@@ -258,7 +267,9 @@ class SphereAreaLight final : public Light {
     const Vec3 n = normalize(p - c_);
     return reverse_ ? -n : n;
   }
-  bool emits_toward(Vec3 n, Vec3 w) const { return two_sided_ ? dot(n, w) != 0.f : dot(n, w) > 0.f; }
+  bool emits_toward(Vec3 n, Vec3 w) const {
+    return two_sided_ ? dot(n, w) != 0.f : dot(n, w) > 0.f;
+  }
 
   Vec3 c_;
   float r_;
@@ -270,7 +281,8 @@ class SphereAreaLight final : public Light {
 
 }  // namespace
 
-LightPtr make_triangle_area_light(const TriangleMesh& mesh, size_t tri, Rgb radiance, bool two_sided) {
+LightPtr make_triangle_area_light(const TriangleMesh& mesh, size_t tri, Rgb radiance,
+                                  bool two_sided) {
   return std::make_shared<TriangleAreaLight>(mesh, tri, radiance, two_sided);
 }
 

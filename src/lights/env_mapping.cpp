@@ -16,7 +16,8 @@ Vec3 equal_area_square_to_sphere(Vec2 uv) {
   const float phi = (r == 0 ? 1 : (av - au) / r + 1) * (kPi / 4);  // in [0, pi/2]
   const float z = std::copysign(1 - r * r, signed_distance);
   const float sin_theta_scale = r * safe_sqrt(2 - r * r);
-  return {std::copysign(std::cos(phi), u) * sin_theta_scale, std::copysign(std::sin(phi), v) * sin_theta_scale, z};
+  return {std::copysign(std::cos(phi), u) * sin_theta_scale,
+          std::copysign(std::sin(phi), v) * sin_theta_scale, z};
 }
 
 Vec2 equal_area_sphere_to_square(Vec3 d) {

@@ -133,10 +133,13 @@ class UniformEnvironment final : public InfiniteLightBase {
 // solid angle per texel) samples it exactly in proportion to luminance.
 class ImageEnvironment final : public InfiniteLightBase {
  public:
-  ImageEnvironment(std::shared_ptr<const Image> image, EnvironmentMapping mapping, const Transform& light_to_world,
-                   Rgb scale)
-      : image_(std::move(image)), mapping_(mapping), light_to_world_(light_to_world),
-        world_to_light_(light_to_world.inverse()), scale_(scale) {
+  ImageEnvironment(std::shared_ptr<const Image> image, EnvironmentMapping mapping,
+                   const Transform& light_to_world, Rgb scale)
+      : image_(std::move(image)),
+        mapping_(mapping),
+        light_to_world_(light_to_world),
+        world_to_light_(light_to_world.inverse()),
+        scale_(scale) {
     if (!image_ || image_->empty()) image_ = std::make_shared<Image>(1, 1, Rgb(0.f));
     const int w = image_->width(), h = image_->height();
     std::vector<float> weights(size_t(w) * h);
@@ -246,7 +249,9 @@ LightPtr make_distant_light(Vec3 direction, Rgb radiance) {
   return std::make_shared<DistantLight>(direction, radiance);
 }
 
-LightPtr make_uniform_environment(Rgb radiance) { return std::make_shared<UniformEnvironment>(radiance); }
+LightPtr make_uniform_environment(Rgb radiance) {
+  return std::make_shared<UniformEnvironment>(radiance);
+}
 
 LightPtr make_image_environment(std::shared_ptr<const Image> image, EnvironmentMapping mapping,
                                 const Transform& light_to_world, Rgb scale) {

@@ -126,7 +126,9 @@ class SpotLight final : public Light {
   Rgb intensity(float cos_axis) const { return I_ * smoothstep(cos_end_, cos_start_, cos_axis); }
 
  private:
-  float dir_pdf(float cos_axis) const { return cos_axis >= cos_end_ ? uniform_cone_pdf(cos_end_) : 0.f; }
+  float dir_pdf(float cos_axis) const {
+    return cos_axis >= cos_end_ ? uniform_cone_pdf(cos_end_) : 0.f;
+  }
 
   Vec3 p_;
   Frame frame_;  // n = spot axis
@@ -142,7 +144,8 @@ LightPtr make_point_light(Vec3 position, Rgb intensity) {
 
 LightPtr make_spot_light(Vec3 position, Vec3 direction, Rgb intensity, float cone_angle_degrees,
                          float cone_delta_degrees) {
-  return std::make_shared<SpotLight>(position, direction, intensity, cone_angle_degrees, cone_delta_degrees);
+  return std::make_shared<SpotLight>(position, direction, intensity, cone_angle_degrees,
+                                     cone_delta_degrees);
 }
 
 }  // namespace caustica

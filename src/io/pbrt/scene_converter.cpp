@@ -432,6 +432,7 @@ MaterialPtr SceneConverter::named_material(const std::string& name, const Source
   if (it == named_materials_.end()) throw SceneLoadError(where, "no material named \"" + name + "\"");
   for (const std::string& c : creating_)
     if (c == name) throw SceneLoadError(where, "material \"" + name + "\" contains itself (through \"mix\")");
+  if (creating_.size() >= 64) throw SceneLoadError(where, "materials nested more than 64 deep (through \"mix\")");
   creating_.push_back(name);
   const MaterialDef& def = it->second;
   MaterialPtr m = factory_.make_material(def.type, def.params, def.where,

@@ -86,12 +86,13 @@ TriangleMesh make_disk(const ParamList& params) {
   const float inner = params.get_float("innerradius", 0);
   const float phi_max = radians(clamp(params.get_float("phimax", 360), 0.f, 360.f));
   TriangleMesh mesh;
+  if (!(phi_max > 0) || radius == inner) return mesh;  // empty
   const int segments = std::max(4, int(std::ceil(256 * phi_max / (2 * kPi))));
   auto ring = [&](float r) {
     for (int i = 0; i <= segments; ++i) {
       const float phi = phi_max * float(i) / float(segments);
       mesh.positions.emplace_back(r * std::cos(phi), r * std::sin(phi), height);
-      mesh.uvs.emplace_back(phi / phi_max, radius != inner ? (radius - r) / (radius - inner) : 0.f);
+      mesh.uvs.emplace_back(phi / phi_max, (radius - r) / (radius - inner));
     }
   };
   ring(radius);

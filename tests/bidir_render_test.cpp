@@ -122,6 +122,8 @@ TEST_P(BidirAgreement, MatchesPathTracer) {
   const double diff = rel_mse(x_avg, pt_avg);
   // Each average has half the variance: expected diff ~ (noise_pt + noise_x) / 4.
   const double bound = 1.5 * (noise_pt + noise_x) / 4 + (integrator == "ppm" ? 0.002 : 0.0);
+  std::printf("[ agreement ] %-14s %-4s relMSE to pt %.5f  bound %.5f  (noise pt %.5f, %s %.5f)\n", scene_name.c_str(),
+              integrator.c_str(), diff, bound, noise_pt, integrator.c_str(), noise_x);
   EXPECT_LT(diff, bound) << scene_name << " " << integrator << ": relMSE to pt " << diff << ", noise pt "
                          << noise_pt << ", noise " << noise_x;
 }

@@ -37,7 +37,7 @@ std::unique_ptr<Scene> load_scene(const std::string& name_or_path, const LoadOpt
   }
   if (ends_with(name_or_path, ".gltf") || ends_with(name_or_path, ".glb")) {
 #ifdef CAUSTICA_HAS_GLTF
-    return load_gltf(name_or_path, options.camera_index, warn);
+    return load_gltf(name_or_path, warn, options.camera_index);
 #endif
   }
   if (looks_like_file)

@@ -11,7 +11,7 @@ namespace caustica {
 
 struct LoadOptions {
   WarningSink warn = nullptr;  // nullptr: warnings go to stderr
-  int camera_index = 0;        // glTF: which camera
+  int camera_index = -1;       // glTF: which camera (-1: the first)
 };
 
 // Throws SceneLoadError for malformed input, std::runtime_error for other failures, and

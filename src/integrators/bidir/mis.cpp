@@ -4,6 +4,12 @@
 
 namespace caustica::bidir {
 
+namespace {
+// 1 / (1 + others). A degenerate vertex (a zero cosine or pdf) can make a partial sum infinite
+// and a product 0 * inf; such a technique is given weight 0, the limit of the finite case.
+float full_weight(float others) { return others == others ? 1.f / (1.f + others) : 0.f; }
+}  // namespace
+
 MisRules::MisRules(MisHeuristic heuristic, bool connect, bool merge, float light_paths, float radius)
     : power_(heuristic == MisHeuristic::Power), light_paths_(light_paths) {
   const float eta_vcm = kPi * radius * radius * light_paths;  // tech. rep. eq. 20
@@ -62,7 +68,7 @@ void MisRules::scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev, 
 float MisRules::hit_light(const MisSums& camera, float direct_pdf, float emission_pdf) const {
   // eqs. 42-43: the light subpath is empty; the camera side sums NEE and all connections.
   const float w_camera = mis(direct_pdf) * camera.vcm + mis(emission_pdf) * camera.vc;
-  return 1.f / (1.f + w_camera);
+  return full_weight(w_camera);
 }
 
 float MisRules::next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf_pdf_rev, float direct_pdf_w,
@@ -72,27 +78,27 @@ float MisRules::next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf
   // eq. 45: emission_pdf_a / direct_pdf_a at the camera vertex; the dist^2 of both cancel.
   const float w_camera = mis(emission_pdf_w * cos_to_light / (direct_pdf_w * cos_at_light)) *
                          (vm_factor_ + camera.vcm + camera.vc * mis(bsdf_pdf_rev));
-  return 1.f / (w_light + 1.f + w_camera);
+  return full_weight(w_light + w_camera);
 }
 
 float MisRules::connect(const MisSums& light, const MisSums& camera, float camera_pdf_a, float camera_rev_w,
                         float light_pdf_a, float light_rev_w) const {
   const float w_light = mis(camera_pdf_a) * (vm_factor_ + light.vcm + light.vc * mis(light_rev_w));     // eq. 40
   const float w_camera = mis(light_pdf_a) * (vm_factor_ + camera.vcm + camera.vc * mis(camera_rev_w));  // eq. 41
-  return 1.f / (w_light + 1.f + w_camera);
+  return full_weight(w_light + w_camera);
 }
 
 float MisRules::light_to_camera(const MisSums& light, float camera_pdf_a, float light_rev_w) const {
   // eq. 46, with the camera density divided by the N light paths that share each pixel.
   const float w_light = mis(camera_pdf_a / light_paths_) * (vm_factor_ + light.vcm + light.vc * mis(light_rev_w));
-  return 1.f / (w_light + 1.f);
+  return full_weight(w_light);
 }
 
 float MisRules::merge(const MisSums& light, const MisSums& camera, float camera_pdf_fwd_w,
                       float camera_pdf_rev_w) const {
   const float w_light = light.vcm * vc_factor_ + light.vm * mis(camera_pdf_fwd_w);     // eq. 38
   const float w_camera = camera.vcm * vc_factor_ + camera.vm * mis(camera_pdf_rev_w);  // eq. 39
-  return 1.f / (w_light + 1.f + w_camera);
+  return full_weight(w_light + w_camera);
 }
 
 }  // namespace caustica::bidir

@@ -1,0 +1,136 @@
+#include "integrators/bidir/path_weights.h"
+
+#include "integrators/bidir/light_vertex.h"
+#include "integrators/bidir/techniques.h"
+#include "lights/light.h"
+#include "lights/light_sampler.h"
+#include "materials/material.h"
+#include "scene/scene.h"
+
+namespace caustica::bidir {
+
+std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm, MisHeuristic heuristic,
+                                                float light_paths, float radius, const ExplicitPath& path,
+                                                ScratchArena& arena) {
+  const bool connect = algorithm != BidirAlgorithm::Bpm;
+  const bool merge = algorithm != BidirAlgorithm::Bpt;
+  const MisRules rules(heuristic, connect, merge, light_paths, radius);
+  const Light& light = *path.light;
+  const float pmf = scene.light_sampler().pmf(&light);
+  const bool finite = !light.is_infinite();
+  const int k = int(path.surfaces.size()) + 1;  // segments
+  const PositionCodec codec(scene.bounds().lo, scene.bounds().hi);
+
+  // Positions x0..xk; for infinite lights x0 is a point far back along the emission direction.
+  std::vector<Vec3> x(k + 1);
+  x[0] = finite ? path.light_point : path.surfaces[0].p - path.emit_dir * 1e3f;
+  for (int i = 1; i < k; ++i) x[i] = path.surfaces[i - 1].p;
+  x[k] = path.lens_point;
+  auto dir = [&](int from, int to) { return normalize(x[to] - x[from]); };
+
+  // Hit records as seen by each subpath (wo toward the subpath's previous vertex), and BSDFs.
+  std::vector<SurfaceInteraction> light_si(k), camera_si(k);
+  std::vector<Bsdf> bsdf(k);
+  for (int i = 1; i < k; ++i) {
+    light_si[i] = camera_si[i] = path.surfaces[i - 1];
+    light_si[i].wo = (i == 1 && !finite) ? -path.emit_dir : dir(i, i - 1);
+    camera_si[i].wo = dir(i, i + 1);
+    bsdf[i] = path.surfaces[i - 1].material->bsdf(path.surfaces[i - 1], arena);
+  }
+  auto delta = [&](int i) { return bsdf[i].is_delta(); };
+
+  // Light subpath replay: sums at x1..x(k-1), stored and reloaded as the renderer does.
+  LightLeSample le;
+  le.p = x[0];
+  le.n = finite ? path.light_normal : path.emit_dir;
+  le.dir = finite ? dir(0, 1) : path.emit_dir;
+  light.pdf_le(le.p, le.n, le.dir, &le.pdf_pos, &le.pdf_dir);
+  le.cos_at_light = light.type() == LightType::Area ? abs_dot(le.n, le.dir) : 1.f;
+  std::vector<MisSums> light_mis(k);
+  for (int i = 1; i < k; ++i) {
+    if (i == 1) {
+      light_mis[1] = light_subpath_start(rules, light, pmf, le, light_si[1], distance(x[0], x[1]));
+    } else {
+      MisSums m = light_mis[i - 1];
+      const bool specular = delta(i - 1);
+      const float pdf_fwd = specular ? 1.f : bsdf[i - 1].pdf(light_si[i - 1].wo, dir(i - 1, i), TransportMode::Importance);
+      scatter_update(rules, m, light_si[i - 1], bsdf[i - 1], light_si[i - 1].wo, dir(i - 1, i), TransportMode::Importance,
+                     specular, pdf_fwd);
+      rules.hit(m, distance_squared(x[i - 1], x[i]), geometric_cos(light_si[i], dir(i, i - 1)));
+      light_mis[i] = m;
+    }
+  }
+  auto stored = [&](int i) {
+    return unpack_light_vertex(pack_light_vertex({x[i], light_si[i].wo, 0, i, Rgb(1.f), light_mis[i]}, codec), codec).mis;
+  };
+
+  // Camera subpath replay: sums at x(k-1) down to x1, and at the emitter (s = 0).
+  std::vector<MisSums> camera_mis(k);
+  camera_mis[k - 1] = rules.camera_start(camera_pdf_w(scene.camera(), dir(k, k - 1)));
+  rules.hit(camera_mis[k - 1], distance_squared(x[k], x[k - 1]), geometric_cos(camera_si[k - 1], dir(k - 1, k)));
+  for (int i = k - 2; i >= 1; --i) {
+    MisSums m = camera_mis[i + 1];
+    const bool specular = delta(i + 1);
+    const float pdf_fwd = specular ? 1.f : bsdf[i + 1].pdf(camera_si[i + 1].wo, dir(i + 1, i), TransportMode::Radiance);
+    scatter_update(rules, m, camera_si[i + 1], bsdf[i + 1], camera_si[i + 1].wo, dir(i + 1, i), TransportMode::Radiance,
+                   specular, pdf_fwd);
+    rules.hit(m, distance_squared(x[i + 1], x[i]), geometric_cos(camera_si[i], dir(i, i + 1)));
+    camera_mis[i] = m;
+  }
+
+  std::vector<TechniqueWeight> out;
+  const Vec3 to_light = finite ? dir(1, 0) : -path.emit_dir;
+  // s = 0: the camera subpath hits the emitter.
+  if (connect && !light.is_delta()) {
+    MisSums m = camera_mis[1];
+    const bool specular = delta(1);
+    const float pdf_fwd = specular ? 1.f : bsdf[1].pdf(camera_si[1].wo, to_light, TransportMode::Radiance);
+    scatter_update(rules, m, camera_si[1], bsdf[1], camera_si[1].wo, to_light, TransportMode::Radiance, specular, pdf_fwd);
+    float w;
+    if (finite) {
+      SurfaceInteraction emitter;
+      emitter.p = x[0];
+      emitter.ng = path.light_normal;
+      emitter.wo = dir(0, 1);
+      rules.hit(m, distance_squared(x[0], x[1]), geometric_cos(emitter, emitter.wo));
+      w = weight_emitter_hit(rules, light, pmf, x[1], to_light, &emitter, m);
+    } else {
+      w = weight_emitter_hit(rules, light, pmf, x[1], to_light, nullptr, m);
+    }
+    out.push_back({false, 0, k + 1, w});
+  }
+  // s = 1: next event estimation from x1.
+  if (connect && !delta(1)) {
+    LightLiSample ls;
+    ls.wi = to_light;
+    ls.distance = finite ? distance(x[0], x[1]) : kInfinity;
+    ls.p_light = x[0];
+    ls.n_light = finite ? path.light_normal : Vec3();
+    ls.pdf_w = light.is_delta() ? 1.f : light.pdf_li(x[1], ls.wi, x[0], ls.n_light);
+    light.pdf_le(x[0], le.n, -ls.wi, &ls.pdf_emit_pos, &ls.pdf_emit_dir);
+    ls.cos_at_light = light.type() == LightType::Area ? abs_dot(path.light_normal, ls.wi) : 1.f;
+    out.push_back({false, 1, k, weight_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1])});
+  }
+  // 2 <= s <= k - 1: connections of x(s-1) and x(s).
+  for (int s = 2; connect && s <= k - 1; ++s) {
+    if (delta(s - 1) || delta(s)) continue;
+    out.push_back({false, s, k + 1 - s,
+                   weight_connection(rules, light_si[s - 1], bsdf[s - 1], light_si[s - 1].wo, stored(s - 1), camera_si[s],
+                                     bsdf[s], camera_mis[s])});
+  }
+  // t = 1: x(k-1) connected to the lens.
+  if (connect && k >= 2 && !delta(k - 1)) {
+    out.push_back({false, k, 1,
+                   weight_light_to_camera(rules, scene.camera(), light_si[k - 1], bsdf[k - 1], light_si[k - 1].wo,
+                                          stored(k - 1), x[k])});
+  }
+  // Merges at every non-delta interior vertex.
+  for (int j = 1; merge && j <= k - 1; ++j) {
+    if (delta(j)) continue;
+    out.push_back({true, j + 1, k + 1 - j,
+                   weight_merge(rules, light_si[j].wo, stored(j), camera_si[j], bsdf[j], camera_mis[j])});
+  }
+  return out;
+}
+
+}  // namespace caustica::bidir

@@ -1,0 +1,42 @@
+// The MIS weights the renderer gives one explicit path under each technique that can make it,
+// computed by replaying both subpaths through the renderer's own update and weight code
+// (techniques.h, with light sums stored and reloaded through the 32-byte light vertex). It is
+// the hook for the tests' brute-force MIS oracle; the renderer never calls it.
+#pragma once
+
+#include <vector>
+
+#include "core/arena.h"
+#include "integrators/bidir/bidir_integrator.h"
+#include "scene/interaction.h"
+
+namespace caustica {
+class Scene;
+class Light;
+}  // namespace caustica
+
+namespace caustica::bidir {
+
+// A path x0 ... xk, light end first: x0 on `light` (for infinite lights only `emit_dir`
+// matters), x1 ... x(k-1) surface hits, xk the lens point.
+struct ExplicitPath {
+  const Light* light = nullptr;
+  Vec3 light_point, light_normal;
+  Vec3 emit_dir;  // propagation direction of infinite lights (unused for finite ones)
+  std::vector<SurfaceInteraction> surfaces;
+  Vec3 lens_point;
+};
+
+struct TechniqueWeight {
+  bool merge = false;
+  int s = 0, t = 0;  // light / camera vertices (a merge counts the merged vertex on both sides)
+  float weight = 0;
+};
+
+// Weights of every technique of `algorithm` (Bpt, Bpm or Vcm) able to produce the path
+// (delta vertices are recognised by Bsdf::is_delta; mixed BSDFs are treated as non-delta).
+std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm, MisHeuristic heuristic,
+                                                float light_paths, float radius, const ExplicitPath& path,
+                                                ScratchArena& arena);
+
+}  // namespace caustica::bidir

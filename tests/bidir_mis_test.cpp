@@ -1,0 +1,282 @@
+// MIS partition of unity for the bidirectional core: for random complete paths, the weights the
+// renderer's partial sums (dVCM, dVC, dVM) give every technique able to make the path must sum to
+// one, and each must equal the weight of a brute-force oracle that multiplies out the pdfs of
+// every vertex explicitly (Veach 1997 ch. 10; Georgiev et al. 2012 eq. 7 and section 4).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+
+#include "core/rng.h"
+#include "integrators/bidir/light_vertex.h"
+#include "integrators/bidir/path_weights.h"
+#include "integrators/bidir/techniques.h"
+#include "io/builtin_scenes.h"
+#include "io/scene_builder.h"
+#include "lights/light.h"
+#include "lights/light_sampler.h"
+#include "lights/lights.h"
+#include "materials/material.h"
+#include "materials/materials.h"
+#include "scene/scene.h"
+#include "scene/texture.h"
+
+using namespace caustica;
+using namespace caustica::bidir;
+
+namespace {
+
+// A small open scene with the light types the Cornell boxes lack: a point light, a spot light
+// and a sphere emitter (cone-sampled NEE), over a diffuse floor with a glass and a rough ball.
+std::unique_ptr<Scene> mixed_lights_scene() {
+  SceneBuilder b;
+  TriangleMesh floor;
+  floor.positions = {{-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}};
+  floor.indices = {0, 2, 1, 0, 3, 2};
+  b.add_mesh(floor, make_diffuse(make_constant_texture(Rgb(0.7f, 0.6f, 0.5f))));
+  TriangleMesh wall;
+  wall.positions = {{-2, 0, 2}, {2, 0, 2}, {2, 3, 2}, {-2, 3, 2}};
+  wall.indices = {0, 1, 2, 0, 2, 3};
+  b.add_mesh(wall, make_diffuse(make_constant_texture(Rgb(0.5f, 0.7f, 0.6f))));
+  DielectricParams glass;
+  glass.eta = 1.5f;
+  b.add_sphere({{-0.6f, 0.5f, 0.3f}, 0.5f}, make_dielectric(glass));
+  ConductorParams rough;
+  rough.reflectance = make_constant_texture(Rgb(0.9f, 0.7f, 0.4f));
+  rough.u_roughness = rough.v_roughness = make_constant_texture(Rgb(0.3f));
+  rough.remap_roughness = false;
+  b.add_sphere({{0.7f, 0.4f, 0.6f}, 0.4f}, make_conductor(rough));
+  AreaEmission e{Rgb(6.f, 5.f, 4.f), false};
+  b.add_sphere({{0.2f, 2.2f, 0.0f}, 0.25f}, make_diffuse(make_constant_texture(Rgb(0.5f))), &e);
+  b.add_light(make_point_light({-1.0f, 2.0f, -1.0f}, Rgb(3.f)));
+  b.add_light(make_spot_light({1.2f, 2.4f, -0.5f}, {-0.3f, -1.f, 0.4f}, Rgb(8.f), 40.f, 10.f));
+  CameraParams c;
+  c.width = c.height = 32;
+  c.fov_degrees = 60;
+  c.camera_to_world = Transform::look_at({0, 1.5f, -4.5f}, {0, 0.6f, 0}, {0, 1, 0}).inverse();
+  b.set_camera(c);
+  return b.build("mis-test");
+}
+
+// Builds a random complete path by tracing a light subpath (Importance mode) of 1-4 surface
+// vertices whose last vertex the camera sees. Returns false if the walk failed.
+bool random_path(const Scene& scene, Pcg32& rng, ScratchArena& arena, ExplicitPath* path) {
+  float pmf;
+  const Light* light = scene.light_sampler().sample(rng.next_float(), &pmf);
+  const Vec2 u_pos = rng.next_2d(), u_dir = rng.next_2d();
+  const auto le = light->sample_le(u_pos, u_dir);
+  if (!le || !(le->pdf_pos > 0) || !(le->pdf_dir > 0)) return false;
+  path->light = light;
+  path->light_point = le->p;
+  path->light_normal = le->n;
+  path->emit_dir = le->dir;
+  path->surfaces.clear();
+  Vec3 o = le->p;
+  if (light->type() == LightType::Area) o = o + face_forward(le->n, le->dir) * 1e-4f;
+  Ray ray{o, le->dir, kInfinity};
+  const int vertices = 1 + int(rng.next_bounded(4));
+  for (int i = 0; i < vertices; ++i) {
+    SurfaceInteraction si;
+    if (!scene.intersect(ray, &si) || !si.material) return false;
+    const Bsdf bsdf = si.material->bsdf(si, arena);
+    if (!bsdf.valid() || si.area_light) return false;  // keep emitters at the path's start only
+    path->surfaces.push_back(si);
+    if (i + 1 == vertices) break;
+    const float uc = rng.next_float();
+    const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Importance);
+    if (!bs) return false;
+    ray = si.spawn_ray(bs->wi);
+  }
+  path->lens_point = scene.camera().position();
+  // Only paths that carry light: every non-delta vertex scatters from its predecessor toward its
+  // successor (a zero BSDF there would leave the camera side unable to sample the path at all).
+  for (size_t i = 0; i < path->surfaces.size(); ++i) {
+    const SurfaceInteraction& si = path->surfaces[i];
+    const Bsdf bsdf = si.material->bsdf(si, arena);
+    if (bsdf.is_delta()) continue;
+    const Vec3 next = i + 1 < path->surfaces.size() ? path->surfaces[i + 1].p : path->lens_point;
+    if (bsdf.f(si.wo, normalize(next - si.p), TransportMode::Importance).is_black()) return false;
+  }
+  const Vec3 last = path->surfaces.back().p;
+  return scene.camera().project(last).has_value() && camera_pdf_w(scene.camera(), normalize(last - path->lens_point)) > 0;
+}
+
+struct Key {
+  bool merge;
+  int s, t;
+  bool operator<(const Key& o) const { return std::tie(merge, s, t) < std::tie(o.merge, o.s, o.t); }
+};
+
+// The oracle: every technique's path pdf as an explicit product of area densities, in double.
+// Conventions shared with the renderer (mis.h): geometric cosines, delta bounces have pdf 1 in
+// both directions, no Russian roulette, n = N for light tracing, merges multiply by N pi r^2.
+std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& path, bool connect, bool merge,
+                                     bool power, double light_paths, double radius, ScratchArena& arena) {
+  const Light& light = *path.light;
+  const bool finite = !light.is_infinite();
+  const double pmf = scene.light_sampler().pmf(&light);
+  const int k = int(path.surfaces.size()) + 1;
+  std::vector<Vec3> x(k + 1);
+  for (int i = 1; i < k; ++i) x[i] = path.surfaces[i - 1].p;
+  x[0] = finite ? path.light_point : x[1] - path.emit_dir * 1e3f;
+  x[k] = path.lens_point;
+  auto dir = [&](int a, int b) { return normalize(x[b] - x[a]); };
+  auto d2 = [&](int a, int b) { return double(distance_squared(x[a], x[b])); };
+  auto cos_at = [&](int i, Vec3 w) {
+    if (i == 0) return light.type() == LightType::Area ? double(abs_dot(path.light_normal, w)) : 1.0;
+    return double(abs_dot(path.surfaces[i - 1].ng, w));
+  };
+  std::vector<Bsdf> bsdf(k);
+  for (int i = 1; i < k; ++i) bsdf[i] = path.surfaces[i - 1].material->bsdf(path.surfaces[i - 1], arena);
+  auto delta = [&](int i) { return bsdf[i].is_delta(); };
+  // Solid angle -> area at x[to] (x0 of an infinite light stays a direction).
+  auto to_area = [&](int from, int to) { return (to == 0 && !finite) ? 1.0 : cos_at(to, dir(to, from)) / d2(from, to); };
+  const Vec3 emit = finite ? dir(0, 1) : path.emit_dir;
+
+  std::vector<double> light_pdf(k), camera_pdf(k);
+  float pdf_pos, pdf_dir;
+  light.pdf_le(x[0], finite ? path.light_normal : path.emit_dir, emit, &pdf_pos, &pdf_dir);
+  light_pdf[0] = pmf * (finite ? pdf_pos : pdf_dir);
+  light_pdf[1] = finite ? pdf_dir * to_area(0, 1) : pdf_pos * cos_at(1, emit);
+  for (int i = 1; i + 1 < k; ++i) {
+    const Vec3 wo = i == 1 ? -emit : dir(i, i - 1);
+    const double p = delta(i) ? 1.0 : bsdf[i].pdf(wo, dir(i, i + 1), TransportMode::Importance);
+    light_pdf[i + 1] = p * to_area(i, i + 1);
+  }
+  camera_pdf[k - 1] = camera_pdf_w(scene.camera(), dir(k, k - 1)) * to_area(k, k - 1);
+  for (int i = k - 1; i >= 1; --i) {
+    const Vec3 wi = i == 1 ? (finite ? dir(1, 0) : -emit) : dir(i, i - 1);
+    const double p = delta(i) ? 1.0 : bsdf[i].pdf(dir(i, i + 1), wi, TransportMode::Radiance);
+    camera_pdf[i - 1] = p * to_area(i, i - 1);
+  }
+  double nee_pdf;
+  if (light.is_delta()) nee_pdf = pmf;
+  else if (finite) nee_pdf = pmf * light.pdf_li(x[1], dir(1, 0), x[0], path.light_normal) * to_area(1, 0);
+  else nee_pdf = pmf * light.pdf_li(x[1], -emit, {}, {});
+
+  auto prod = [](const std::vector<double>& v, int lo, int hi) {  // product over [lo, hi]
+    double p = 1;
+    for (int i = lo; i <= hi; ++i) p *= v[i];
+    return p;
+  };
+  std::map<Key, double> p;
+  if (connect && !light.is_delta()) p[{false, 0, k + 1}] = prod(camera_pdf, 0, k - 1);
+  if (connect && !delta(1)) p[{false, 1, k}] = nee_pdf * prod(camera_pdf, 1, k - 1);
+  for (int s = 2; connect && s <= k - 1; ++s)
+    if (!delta(s - 1) && !delta(s)) p[{false, s, k + 1 - s}] = prod(light_pdf, 0, s - 1) * prod(camera_pdf, s, k - 1);
+  if (connect && !delta(k - 1)) p[{false, k, 1}] = light_paths * prod(light_pdf, 0, k - 1);
+  for (int j = 1; merge && j <= k - 1; ++j)
+    if (!delta(j)) p[{true, j + 1, k + 1 - j}] = light_paths * kPi * radius * radius * prod(light_pdf, 0, j) * prod(camera_pdf, j, k - 1);
+  double total = 0;
+  for (auto& [key, v] : p) {
+    v = power ? v * v : v;
+    total += v;
+  }
+  for (auto& [key, v] : p) v /= total;
+  return p;
+}
+
+struct Case {
+  const char* scene;
+  BidirAlgorithm algorithm;
+  MisHeuristic heuristic;
+};
+
+void check_partition_of_unity(const Scene& scene, const Case& c, int paths) {
+  Pcg32 rng(7, 11);
+  ScratchArena arena;
+  const float light_paths = 1024, radius = 0.02f;
+  const bool connect = c.algorithm != BidirAlgorithm::Bpm, merge = c.algorithm != BidirAlgorithm::Bpt;
+  int checked = 0, attempts = 0, with_delta = 0;
+  double worst_sum = 0, worst_oracle = 0;
+  ExplicitPath path;
+  while (checked < paths && attempts < 50 * paths) {
+    ++attempts;
+    arena.reset();
+    if (!random_path(scene, rng, arena, &path)) continue;
+    const auto weights = production_weights(scene, c.algorithm, c.heuristic, light_paths, radius, path, arena);
+    const auto oracle = oracle_weights(scene, path, connect, merge, c.heuristic == MisHeuristic::Power, light_paths,
+                                       radius, arena);
+    if (oracle.empty() || !std::isfinite(oracle.begin()->second)) continue;  // no technique can make it
+    double sum = 0;
+    for (const auto& w : weights) {
+      sum += w.weight;
+      const auto it = oracle.find({w.merge, w.s, w.t});
+      ASSERT_NE(it, oracle.end()) << c.scene << ": production technique the oracle lacks: merge " << w.merge << " s "
+                                  << w.s << " t " << w.t;
+      worst_oracle = std::max(worst_oracle, std::abs(double(w.weight) - it->second));
+      EXPECT_NEAR(w.weight, it->second, 1e-3) << c.scene << " merge " << w.merge << " s " << w.s << " t " << w.t
+                                              << " k " << path.surfaces.size() + 1 << " path " << checked;
+    }
+    ASSERT_EQ(weights.size(), oracle.size()) << c.scene;
+    worst_sum = std::max(worst_sum, std::abs(sum - 1));
+    for (const SurfaceInteraction& si : path.surfaces)
+      if (si.material->bsdf(si, arena).is_delta()) {
+        ++with_delta;
+        break;
+      }
+    ASSERT_NEAR(sum, 1.0, 1e-4) << c.scene << " path " << checked << " with " << weights.size() << " techniques";
+    ++checked;
+  }
+  EXPECT_EQ(checked, paths) << c.scene << ": could not build enough paths";
+  std::printf("[ partition ] %-14s %d paths (%d through delta vertices), max |sum - 1| = %.2e, max |w - oracle| = %.2e\n",
+              c.scene, checked, with_delta, worst_sum, worst_oracle);
+}
+
+std::unique_ptr<Scene> scene_named(const std::string& name) {
+  if (name == "mixed-lights") return mixed_lights_scene();
+  return make_builtin_scene(name, 32, 32);
+}
+
+}  // namespace
+
+class BidirMisPartition : public ::testing::TestWithParam<Case> {};
+
+TEST_P(BidirMisPartition, WeightsSumToOneAndMatchBruteForce) {
+  const Case c = GetParam();
+  auto scene = scene_named(c.scene);
+  check_partition_of_unity(*scene, c, 10000);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Bidir, BidirMisPartition,
+    ::testing::Values(Case{"cornell", BidirAlgorithm::Vcm, MisHeuristic::Balance},
+                      Case{"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Balance},
+                      Case{"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Power},
+                      Case{"cornell-glass", BidirAlgorithm::Bpt, MisHeuristic::Balance},
+                      Case{"cornell-glass", BidirAlgorithm::Bpm, MisHeuristic::Balance},
+                      Case{"mixed-lights", BidirAlgorithm::Vcm, MisHeuristic::Balance},
+                      Case{"env-furnace", BidirAlgorithm::Vcm, MisHeuristic::Power}),
+    [](const auto& info) {
+      std::string n = std::string(info.param.scene) + "_" + std::to_string(int(info.param.algorithm)) + "_" +
+                      (info.param.heuristic == MisHeuristic::Power ? "power" : "balance");
+      for (char& ch : n)
+        if (ch == '-') ch = '_';
+      return n;
+    });
+
+TEST(BidirLightVertex, PackingRoundTrips) {
+  const PositionCodec codec({-1, -2, -3}, {4, 5, 6});
+  std::mt19937 gen(3);
+  std::uniform_real_distribution<float> u(0, 1);
+  for (int i = 0; i < 1000; ++i) {
+    LightVertexData v;
+    v.p = {-1 + 5 * u(gen), -2 + 7 * u(gen), -3 + 9 * u(gen)};
+    v.wo = normalize(Vec3(u(gen) - 0.5f, u(gen) - 0.5f, u(gen) - 0.5f));
+    v.primitive = uint32_t(gen());
+    v.depth = int(gen() % 200);
+    v.throughput = Rgb(u(gen), u(gen), u(gen)) * std::ldexp(1.f, int(gen() % 60) - 30);
+    v.mis = {std::ldexp(u(gen), int(gen() % 80) - 40), std::ldexp(u(gen), int(gen() % 80) - 40), u(gen)};
+    const LightVertexData r = unpack_light_vertex(pack_light_vertex(v, codec), codec);
+    EXPECT_LT(distance(r.p, v.p), 1e-5f);
+    EXPECT_LT(length(r.wo - v.wo), 2e-4f);  // angle in radians, to first order
+    EXPECT_EQ(r.primitive, v.primitive);
+    EXPECT_EQ(r.depth, v.depth);
+    const float m = v.throughput.max_component();
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.throughput[c], v.throughput[c], m * 1.3e-4f);
+    EXPECT_NEAR(r.mis.vcm, v.mis.vcm, v.mis.vcm * 1e-5f);
+    EXPECT_NEAR(r.mis.vc, v.mis.vc, v.mis.vc * 1e-5f);
+    EXPECT_NEAR(r.mis.vm, v.mis.vm, v.mis.vm * 1e-5f);
+  }
+}

@@ -129,7 +129,7 @@ TEST(PbrtParams, UnusedParametersWarnOnce) {
   p.report_unused(w, "Camera \"perspective\"");
   ASSERT_EQ(test::captured_warnings().size(), 1u);
   EXPECT_EQ(test::captured_warnings()[0],
-            "p.pbrt:1:16: warning: Camera \"perspective\": parameter \"float fvo\" is not supported; ignored");
+            "p.pbrt:1:16: warning: Camera \"perspective\": parameter \"float fvo\" is unknown or not supported; ignored");
 }
 
 struct ErrorCase {

@@ -35,6 +35,7 @@ struct RenderOptions {
   uint64_t light_paths = 0;
   float radius = 0, radius_alpha = 0.75f;
   std::string techniques_dir;
+  int camera = -1;
   bool quiet = false;
 };
 
@@ -76,7 +77,9 @@ int run_render(const RenderOptions& o) {
   std::unique_ptr<Scene> scene;
   const auto load_start = std::chrono::steady_clock::now();
   try {
-    scene = load_scene(scene_name);
+    LoadOptions load;
+    load.camera_index = o.camera;
+    scene = load_scene(scene_name, load);
   } catch (const UnknownSceneError& e) {
     std::fprintf(stderr, "caustica render: error: %s\n", e.what());
     return 2;
@@ -177,6 +180,7 @@ Runner add_render_command(CLI::App& app) {
   cmd->add_option("--radius", opts->radius, "Photon mapping / VCM: initial merge radius (default: from scene size)");
   cmd->add_option("--radius-alpha", opts->radius_alpha, "Photon mapping / VCM: radius reduction alpha (default 0.75)");
   cmd->add_option("--techniques", opts->techniques_dir, "Bidirectional: write one weighted image per technique to DIR");
+  cmd->add_option("--camera", opts->camera, "glTF: which camera to use, in node order (default: the first)");
   cmd->add_flag("--quiet,-q", opts->quiet, "No progress bar or summary");
   return [opts] { return run_render(*opts); };
 }

@@ -318,7 +318,6 @@ class BidirIntegrator final : public Integrator {
     MisSums mis;
     float segment = 0;  // distance since the previous real vertex (interfaces are skipped)
     int depth = 0;
-    float eta_scale = 1;
     for (;;) {
       SurfaceInteraction si;
       if (!scene.intersect(ray, &si)) break;
@@ -353,10 +352,10 @@ class BidirIntegrator final : public Integrator {
       const float pdf_fwd = bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Importance) : bs->pdf;
       bidir::scatter_update(it.rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Importance, bs->is_specular(), pdf_fwd);
       beta *= bs->f * (bsdf.abs_cos(bs->wi) / bs->pdf);
-      if (bs->is_transmission()) eta_scale *= sqr(bs->eta);
       if (beta.is_black()) break;
       ray = si.spawn_ray(bs->wi);
-      // Russian roulette on the throughput relative to the emitted one.
+      // Russian roulette on the throughput relative to the emitted one (importance carries no
+      // radiance scaling at refractions, so no eta correction).
       const float rr = beta.max_component() / beta_start;
       if (rr < 1 && depth > 1) {
         const float q = std::max(0.f, 1 - rr);
@@ -364,7 +363,6 @@ class BidirIntegrator final : public Integrator {
         beta = beta / (1 - q);
       }
     }
-    (void)eta_scale;
   }
 
   // t = 1: the light vertex seen through a lens point; splat recorded in the chunk.

@@ -1,6 +1,6 @@
-#define TINYGLTF_IMPLEMENTATION
+// tinygltf is compiled once, in tinygltf_impl.cpp; this file sees only its declarations.
 #define TINYGLTF_NO_STB_IMAGE_WRITE
-// The stb_image implementation comes from libstb (linked by caustica_lib).
+#define TINYGLTF_NO_INCLUDE_STB_IMAGE_WRITE
 #include <tiny_gltf.h>
 
 #include "io/gltf/gltf_loader.h"

@@ -262,7 +262,7 @@ std::vector<Vec2> ParamList::get_point2s(std::string_view name) const {
 void ParamList::report_unused(Warnings& warnings, const std::string& context) const {
   for (const Param& p : params_)
     if (!p.used)
-      warnings.warn(p.where, context + ": parameter " + p.declaration() + " is not supported; ignored",
+      warnings.warn(p.where, context + ": parameter " + p.declaration() + " is unknown or not supported; ignored",
                     "unused " + context + " " + p.declaration());
 }
 

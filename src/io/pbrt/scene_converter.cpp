@@ -254,7 +254,7 @@ void SceneConverter::handle(const Directive& d) {
     for (const char* r : {"xresolution", "yresolution"})
       if (const Param* p = d.params.find(r))
         if (!(p->numbers[0] >= 1 && p->numbers[0] <= 65536)) param_error(*p, "expected a resolution between 1 and 65536");
-    builder_.settings().output_name = d.params.get_string("filename", "pbrt.exr");
+    if (d.params.find("filename")) builder_.settings().output_name = d.params.get_string("filename", "");
     d.params.report_unused(ctx_.warnings, "Film \"" + d.args[0] + "\"");
     return;
   }

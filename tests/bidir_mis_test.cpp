@@ -99,7 +99,8 @@ bool random_path(const Scene& scene, Pcg32& rng, ScratchArena& arena, ExplicitPa
     if (bsdf.f(si.wo, normalize(next - si.p), TransportMode::Importance).is_black()) return false;
   }
   const Vec3 last = path->surfaces.back().p;
-  return scene.camera().project(last).has_value() && camera_pdf_w(scene.camera(), normalize(last - path->lens_point)) > 0;
+  return scene.camera().project(last).has_value() &&
+         camera_pdf_w(scene.camera(), normalize(last - path->lens_point)) > 0;
 }
 
 struct Key {
@@ -111,8 +112,9 @@ struct Key {
 // The oracle: every technique's path pdf as an explicit product of area densities, in double.
 // Conventions shared with the renderer (mis.h): geometric cosines, delta bounces have pdf 1 in
 // both directions, no Russian roulette, n = N for light tracing, merges multiply by N pi r^2.
-std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& path, bool connect, bool merge,
-                                     bool power, double light_paths, double radius, ScratchArena& arena) {
+std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& path, bool connect,
+                                     bool merge, bool power, double light_paths, double radius,
+                                     ScratchArena& arena) {
   const Light& light = *path.light;
   const bool finite = !light.is_infinite();
   const double pmf = scene.light_sampler().pmf(&light);
@@ -124,14 +126,18 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
   auto dir = [&](int a, int b) { return normalize(x[b] - x[a]); };
   auto d2 = [&](int a, int b) { return double(distance_squared(x[a], x[b])); };
   auto cos_at = [&](int i, Vec3 w) {
-    if (i == 0) return light.type() == LightType::Area ? double(abs_dot(path.light_normal, w)) : 1.0;
+    if (i == 0)
+      return light.type() == LightType::Area ? double(abs_dot(path.light_normal, w)) : 1.0;
     return double(abs_dot(path.surfaces[i - 1].ng, w));
   };
   std::vector<Bsdf> bsdf(k);
-  for (int i = 1; i < k; ++i) bsdf[i] = path.surfaces[i - 1].material->bsdf(path.surfaces[i - 1], arena);
+  for (int i = 1; i < k; ++i)
+    bsdf[i] = path.surfaces[i - 1].material->bsdf(path.surfaces[i - 1], arena);
   auto delta = [&](int i) { return bsdf[i].is_delta(); };
   // Solid angle -> area at x[to] (x0 of an infinite light stays a direction).
-  auto to_area = [&](int from, int to) { return (to == 0 && !finite) ? 1.0 : cos_at(to, dir(to, from)) / d2(from, to); };
+  auto to_area = [&](int from, int to) {
+    return (to == 0 && !finite) ? 1.0 : cos_at(to, dir(to, from)) / d2(from, to);
+  };
   const Vec3 emit = finite ? dir(0, 1) : path.emit_dir;
 
   std::vector<double> light_pdf(k), camera_pdf(k);
@@ -151,9 +157,12 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
     camera_pdf[i - 1] = p * to_area(i, i - 1);
   }
   double nee_pdf;
-  if (light.is_delta()) nee_pdf = pmf;
-  else if (finite) nee_pdf = pmf * light.pdf_li(x[1], dir(1, 0), x[0], path.light_normal) * to_area(1, 0);
-  else nee_pdf = pmf * light.pdf_li(x[1], -emit, {}, {});
+  if (light.is_delta())
+    nee_pdf = pmf;
+  else if (finite)
+    nee_pdf = pmf * light.pdf_li(x[1], dir(1, 0), x[0], path.light_normal) * to_area(1, 0);
+  else
+    nee_pdf = pmf * light.pdf_li(x[1], -emit, {}, {});
 
   auto prod = [](const std::vector<double>& v, int lo, int hi) {  // product over [lo, hi]
     double p = 1;
@@ -164,10 +173,13 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
   if (connect && !light.is_delta()) p[{false, 0, k + 1}] = prod(camera_pdf, 0, k - 1);
   if (connect && !delta(1)) p[{false, 1, k}] = nee_pdf * prod(camera_pdf, 1, k - 1);
   for (int s = 2; connect && s <= k - 1; ++s)
-    if (!delta(s - 1) && !delta(s)) p[{false, s, k + 1 - s}] = prod(light_pdf, 0, s - 1) * prod(camera_pdf, s, k - 1);
+    if (!delta(s - 1) && !delta(s))
+      p[{false, s, k + 1 - s}] = prod(light_pdf, 0, s - 1) * prod(camera_pdf, s, k - 1);
   if (connect && !delta(k - 1)) p[{false, k, 1}] = light_paths * prod(light_pdf, 0, k - 1);
   for (int j = 1; merge && j <= k - 1; ++j)
-    if (!delta(j)) p[{true, j + 1, k + 1 - j}] = light_paths * kPi * radius * radius * prod(light_pdf, 0, j) * prod(camera_pdf, j, k - 1);
+    if (!delta(j))
+      p[{true, j + 1, k + 1 - j}] =
+          light_paths * kPi * radius * radius * prod(light_pdf, 0, j) * prod(camera_pdf, j, k - 1);
   double total = 0;
   for (auto& [key, v] : p) {
     v = power ? v * v : v;
@@ -187,7 +199,8 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths) {
   Pcg32 rng(7, 11);
   ScratchArena arena;
   const float light_paths = 1024, radius = 0.02f;
-  const bool connect = c.algorithm != BidirAlgorithm::Bpm, merge = c.algorithm != BidirAlgorithm::Bpt;
+  const bool connect = c.algorithm != BidirAlgorithm::Bpm,
+             merge = c.algorithm != BidirAlgorithm::Bpt;
   int checked = 0, attempts = 0, with_delta = 0;
   double worst_sum = 0, worst_oracle = 0;
   ExplicitPath path;
@@ -195,19 +208,23 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths) {
     ++attempts;
     arena.reset();
     if (!random_path(scene, rng, arena, &path)) continue;
-    const auto weights = production_weights(scene, c.algorithm, c.heuristic, light_paths, radius, path, arena);
-    const auto oracle = oracle_weights(scene, path, connect, merge, c.heuristic == MisHeuristic::Power, light_paths,
-                                       radius, arena);
-    if (oracle.empty() || !std::isfinite(oracle.begin()->second)) continue;  // no technique can make it
+    const auto weights =
+        production_weights(scene, c.algorithm, c.heuristic, light_paths, radius, path, arena);
+    const auto oracle =
+        oracle_weights(scene, path, connect, merge, c.heuristic == MisHeuristic::Power, light_paths,
+                       radius, arena);
+    if (oracle.empty() || !std::isfinite(oracle.begin()->second))
+      continue;  // no technique can make it
     double sum = 0;
     for (const auto& w : weights) {
       sum += w.weight;
       const auto it = oracle.find({w.merge, w.s, w.t});
-      ASSERT_NE(it, oracle.end()) << c.scene << ": production technique the oracle lacks: merge " << w.merge << " s "
-                                  << w.s << " t " << w.t;
+      ASSERT_NE(it, oracle.end()) << c.scene << ": production technique the oracle lacks: merge "
+                                  << w.merge << " s " << w.s << " t " << w.t;
       worst_oracle = std::max(worst_oracle, std::abs(double(w.weight) - it->second));
-      EXPECT_NEAR(w.weight, it->second, 1e-3) << c.scene << " merge " << w.merge << " s " << w.s << " t " << w.t
-                                              << " k " << path.surfaces.size() + 1 << " path " << checked;
+      EXPECT_NEAR(w.weight, it->second, 1e-3)
+          << c.scene << " merge " << w.merge << " s " << w.s << " t " << w.t << " k "
+          << path.surfaces.size() + 1 << " path " << checked;
     }
     ASSERT_EQ(weights.size(), oracle.size()) << c.scene;
     worst_sum = std::max(worst_sum, std::abs(sum - 1));
@@ -216,12 +233,15 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths) {
         ++with_delta;
         break;
       }
-    ASSERT_NEAR(sum, 1.0, 1e-4) << c.scene << " path " << checked << " with " << weights.size() << " techniques";
+    ASSERT_NEAR(sum, 1.0, 1e-4) << c.scene << " path " << checked << " with " << weights.size()
+                                << " techniques";
     ++checked;
   }
   EXPECT_EQ(checked, paths) << c.scene << ": could not build enough paths";
-  std::printf("[ partition ] %-14s %d paths (%d through delta vertices), max |sum - 1| = %.2e, max |w - oracle| = %.2e\n",
-              c.scene, checked, with_delta, worst_sum, worst_oracle);
+  std::printf(
+      "[ partition ] %-14s %d paths (%d through delta vertices), max |sum - 1| = %.2e, max |w - "
+      "oracle| = %.2e\n",
+      c.scene, checked, with_delta, worst_sum, worst_oracle);
 }
 
 std::unique_ptr<Scene> scene_named(const std::string& name) {
@@ -249,7 +269,8 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"mixed-lights", BidirAlgorithm::Vcm, MisHeuristic::Balance},
                       Case{"env-furnace", BidirAlgorithm::Vcm, MisHeuristic::Power}),
     [](const auto& info) {
-      std::string n = std::string(info.param.scene) + "_" + std::to_string(int(info.param.algorithm)) + "_" +
+      std::string n = std::string(info.param.scene) + "_" +
+                      std::to_string(int(info.param.algorithm)) + "_" +
                       (info.param.heuristic == MisHeuristic::Power ? "power" : "balance");
       for (char& ch : n)
         if (ch == '-') ch = '_';
@@ -267,7 +288,8 @@ TEST(BidirLightVertex, PackingRoundTrips) {
     v.primitive = uint32_t(gen());
     v.depth = int(gen() % 200);
     v.throughput = Rgb(u(gen), u(gen), u(gen)) * std::ldexp(1.f, int(gen() % 60) - 30);
-    v.mis = {std::ldexp(u(gen), int(gen() % 80) - 40), std::ldexp(u(gen), int(gen() % 80) - 40), u(gen)};
+    v.mis = {std::ldexp(u(gen), int(gen() % 80) - 40), std::ldexp(u(gen), int(gen() % 80) - 40),
+             u(gen)};
     const LightVertexData r = unpack_light_vertex(pack_light_vertex(v, codec), codec);
     EXPECT_LT(distance(r.p, v.p), 1e-5f);
     EXPECT_LT(length(r.wo - v.wo), 2e-4f);  // angle in radians, to first order

@@ -20,7 +20,8 @@ namespace {
 struct RunStats {
   double mean = 0, standard_error = 0;
 };
-RunStats stats_over_seeds(const Scene& scene, const std::string& integrator, int spp, IntegratorSettings s, int runs) {
+RunStats stats_over_seeds(const Scene& scene, const std::string& integrator, int spp,
+                          IntegratorSettings s, int runs) {
   std::vector<double> means;
   for (int k = 0; k < runs; ++k) {
     s.seed = 1000 + k;
@@ -78,7 +79,8 @@ TEST(BidirFurnace, ProgressivePhotonMappingWithinShrinkingBiasBound) {
   const int spp = 8;
   const RunStats st = stats_over_seeds(*scene, "ppm", spp, s, 6);
   const double shrink = std::pow(double(spp), s.radius_alpha - 1.0);  // (r_i / r_1)^2
-  EXPECT_NEAR(st.mean, p.expected_radiance(), 3 * st.standard_error + 0.01 * shrink * p.expected_radiance())
+  EXPECT_NEAR(st.mean, p.expected_radiance(),
+              3 * st.standard_error + 0.01 * shrink * p.expected_radiance())
       << "mean " << st.mean << " se " << st.standard_error;
 }
 
@@ -96,13 +98,14 @@ TEST(BidirFurnace, EnvironmentFurnaceIsInvisible) {
 // a common normalisation (the pt average as reference, eps 0.01 as rel_mse), d(a, b) = mean of
 // (a - b)^2 / (ref^2 + eps) gives E[d(x1, x2)] = 2 v_x for two independent renders of an unbiased
 // integrator with normalised variance v_x. Comparing the averages of two renders each,
-// E[d(avg_x, avg_pt)] = v_x / 2 + v_pt / 2 + bias^2 = (n_x + n_pt) / 4 with n = d(render 1, render 2).
-// The test requires d(avg_x, avg_pt) < 1.5 (n_x + n_pt) / 4: a bias adds to the left side only.
+// E[d(avg_x, avg_pt)] = v_x / 2 + v_pt / 2 + bias^2 = (n_x + n_pt) / 4 with n = d(render 1, render
+// 2). The test requires d(avg_x, avg_pt) < 1.5 (n_x + n_pt) / 4: a bias adds to the left side only.
 namespace {
 double normalised_diff(const Image& a, const Image& b, const Image& ref) {
   double sum = 0;
   for (size_t i = 0; i < a.pixel_count(); ++i)
-    for (int c = 0; c < 3; ++c) sum += sqr(double(a[i][c]) - b[i][c]) / (sqr(double(ref[i][c])) + 0.01);
+    for (int c = 0; c < 3; ++c)
+      sum += sqr(double(a[i][c]) - b[i][c]) / (sqr(double(ref[i][c])) + 0.01);
   return sum / (3.0 * a.pixel_count());
 }
 }  // namespace
@@ -131,12 +134,15 @@ TEST_P(BidirAgreement, MatchesPathTracer) {
   Image pt_avg = add(pt_a, pt_b), x_avg = add(x_a, x_b);
   for (Rgb& v : pt_avg.pixels()) v *= 0.5f;
   for (Rgb& v : x_avg.pixels()) v *= 0.5f;
-  const double noise_pt = normalised_diff(pt_a, pt_b, pt_avg), noise_x = normalised_diff(x_a, x_b, pt_avg);
+  const double noise_pt = normalised_diff(pt_a, pt_b, pt_avg),
+               noise_x = normalised_diff(x_a, x_b, pt_avg);
   const double diff = normalised_diff(x_avg, pt_avg, pt_avg);
   const double expected = (noise_pt + noise_x) / 4, bound = 1.5 * expected;
-  std::printf("[ agreement ] %-14s %-4s diff %.5f  expected from noise %.5f  (pt %.5f, %s %.5f); rel_mse %.5f\n",
-              scene_name.c_str(), integrator.c_str(), diff, expected, noise_pt, integrator.c_str(), noise_x,
-              rel_mse(x_avg, pt_avg));
+  std::printf(
+      "[ agreement ] %-14s %-4s diff %.5f  expected from noise %.5f  (pt %.5f, %s %.5f); rel_mse "
+      "%.5f\n",
+      scene_name.c_str(), integrator.c_str(), diff, expected, noise_pt, integrator.c_str(), noise_x,
+      rel_mse(x_avg, pt_avg));
   EXPECT_LT(diff, bound) << scene_name << " " << integrator;
 }
 
@@ -168,7 +174,8 @@ TEST(BidirDeterminism, BitIdenticalForOneAndTwoThreads) {
 TEST(BidirTechniques, ImagesSumToTheFinalImage) {
   auto scene = make_builtin_scene("cornell-glass", 24, 24);
   for (const char* name : {"vcm", "bpt", "lt"}) {
-    const auto dir = std::filesystem::temp_directory_path() / ("caustica_bidir_techniques_" + std::string(name));
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("caustica_bidir_techniques_" + std::string(name));
     std::filesystem::remove_all(dir);
     IntegratorSettings s;
     s.max_depth = 6;
@@ -184,7 +191,8 @@ TEST(BidirTechniques, ImagesSumToTheFinalImage) {
     double max_err = 0;
     for (size_t i = 0; i < sum.pixel_count(); ++i)
       for (int c = 0; c < 3; ++c)
-        max_err = std::max(max_err, double(std::abs(sum[i][c] - r.image[i][c])) / (1e-3 + std::abs(r.image[i][c])));
+        max_err = std::max(max_err, double(std::abs(sum[i][c] - r.image[i][c])) /
+                                        (1e-3 + std::abs(r.image[i][c])));
     EXPECT_LT(max_err, 1e-4) << name;
     std::filesystem::remove_all(dir);
   }

@@ -1,12 +1,13 @@
 // The glTF loader on a file written by the test: node transforms, the camera convention
 // (glTF looks down -z), emissive materials as area lights, KHR_lights_punctual.
+#include "io/gltf/gltf_loader.h"
+
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <string>
 #include <vector>
 
-#include "io/gltf/gltf_loader.h"
 #include "lights/light.h"
 #include "pbrt_test_util.h"
 #include "scene/interaction.h"
@@ -18,7 +19,8 @@ std::string base64(const std::vector<unsigned char>& in) {
   static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   for (size_t i = 0; i < in.size(); i += 3) {
-    const uint32_t n = (uint32_t(in[i]) << 16) | (i + 1 < in.size() ? uint32_t(in[i + 1]) << 8 : 0) |
+    const uint32_t n = (uint32_t(in[i]) << 16) |
+                       (i + 1 < in.size() ? uint32_t(in[i + 1]) << 8 : 0) |
                        (i + 2 < in.size() ? uint32_t(in[i + 2]) : 0);
     out += table[(n >> 18) & 63];
     out += table[(n >> 12) & 63];

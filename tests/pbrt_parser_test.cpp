@@ -66,9 +66,7 @@ TEST(PbrtTokenizer, UnterminatedStringIsAnErrorAtItsStart) {
   }
 }
 
-TEST(PbrtTokenizer, BadEscapeIsAnError) {
-  EXPECT_THROW(tokenize(R"("a\qb")"), SceneLoadError);
-}
+TEST(PbrtTokenizer, BadEscapeIsAnError) { EXPECT_THROW(tokenize(R"("a\qb")"), SceneLoadError); }
 
 ParamList params(const std::string& text) {
   Tokenizer t(text, "p.pbrt");
@@ -129,7 +127,8 @@ TEST(PbrtParams, UnusedParametersWarnOnce) {
   p.report_unused(w, "Camera \"perspective\"");
   ASSERT_EQ(test::captured_warnings().size(), 1u);
   EXPECT_EQ(test::captured_warnings()[0],
-            "p.pbrt:1:16: warning: Camera \"perspective\": parameter \"float fvo\" is unknown or not supported; ignored");
+            "p.pbrt:1:16: warning: Camera \"perspective\": parameter \"float fvo\" is unknown or "
+            "not supported; ignored");
 }
 
 struct ErrorCase {
@@ -148,54 +147,78 @@ TEST(PbrtErrors, ReportExactPositionAndWhatWasExpected) {
        "test.pbrt:2:31: error: missing \"]\" to close the \"[\" of \"float radius\""},
       {"WorldBegin\nShape \"sphere\" \"float radius\" ]",
        "test.pbrt:2:31: error: \"float radius\": expected a value or \"[\", got \"]\""},
-      {"WorldBegin\nAttributeEnd", "test.pbrt:2:1: error: AttributeEnd without a matching AttributeBegin"},
+      {"WorldBegin\nAttributeEnd",
+       "test.pbrt:2:1: error: AttributeEnd without a matching AttributeBegin"},
       {"WorldBegin\nAttributeBegin\nShape \"sphere\"\n",
-       "test.pbrt:2:1: error: AttributeBegin has no matching AttributeEnd before the end of the file"},
+       "test.pbrt:2:1: error: AttributeBegin has no matching AttributeEnd before the end of the "
+       "file"},
       {"WorldBegin\nAttributeBegin\nTransformEnd",
        "test.pbrt:3:1: error: TransformEnd does not match the AttributeBegin at test.pbrt:2:1"},
       {"Translate 1 2", "test.pbrt:1:14: error: Translate: expected 3 numbers, got end of file"},
       {"Translate 1 x 2", "test.pbrt:1:13: error: Translate: expected 3 numbers, got \"x\""},
       {"Transform [ 1 0 0 0 1 ]", "test.pbrt:1:23: error: Transform: expected 16 numbers, got 5"},
-      {"Transform 1 0 0", "test.pbrt:1:11: error: Transform: expected \"[\" followed by 16 numbers, got \"1\""},
+      {"Transform 1 0 0",
+       "test.pbrt:1:11: error: Transform: expected \"[\" followed by 16 numbers, got \"1\""},
       {"WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 ]",
        "test.pbrt:2:22: error: \"point3 P\": expected a multiple of 3 values, got 8"},
-      {"WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 3 ]",
-       "test.pbrt:2:55: error: \"integer indices\": vertex index 3 is out of range (3 vertices in \"point3 P\")"},
-      {"WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 ]",
-       "test.pbrt:2:55: error: \"integer indices\": expected a multiple of 3 indices (3 per triangle), got 2"},
+      {"WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" "
+       "[ 0 1 3 ]",
+       "test.pbrt:2:55: error: \"integer indices\": vertex index 3 is out of range (3 vertices in "
+       "\"point3 P\")"},
+      {"WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" "
+       "[ 0 1 ]",
+       "test.pbrt:2:55: error: \"integer indices\": expected a multiple of 3 indices (3 per "
+       "triangle), got 2"},
       {"WorldBegin\nShape \"sphere\" \"integer radius\" 1.5",
        "test.pbrt:2:33: error: \"integer radius\": expected an integer, got \"1.5\""},
-      {"WorldBegin\nShape \"sphere\" \"rgb L\" [ 1 2 ]", "test.pbrt:2:16: error: \"rgb L\": expected exactly 3 values, got 2"},
-      {"WorldBegin\nShape \"sphere\" \"bool b\" yes", "test.pbrt:2:25: error: \"bool b\": expected true or false, got \"yes\""},
-      {"WorldBegin\nShape \"teapot\"", "test.pbrt:2:1: error: unknown shape \"teapot\" (expected trianglemesh, plymesh, "
-                                      "bilinearmesh, sphere, disk, cylinder, curve or loopsubdiv)"},
-      {"WorldBegin\nNamedMaterial \"nope\"\nShape \"sphere\"", "test.pbrt:2:15: error: no material named \"nope\""},
-      {"WorldBegin\nMaterial \"plastic\"\nShape \"sphere\"", "test.pbrt:2:1: error: unknown material type \"plastic\""},
+      {"WorldBegin\nShape \"sphere\" \"rgb L\" [ 1 2 ]",
+       "test.pbrt:2:16: error: \"rgb L\": expected exactly 3 values, got 2"},
+      {"WorldBegin\nShape \"sphere\" \"bool b\" yes",
+       "test.pbrt:2:25: error: \"bool b\": expected true or false, got \"yes\""},
+      {"WorldBegin\nShape \"teapot\"",
+       "test.pbrt:2:1: error: unknown shape \"teapot\" (expected trianglemesh, plymesh, "
+       "bilinearmesh, sphere, disk, cylinder, curve or loopsubdiv)"},
+      {"WorldBegin\nNamedMaterial \"nope\"\nShape \"sphere\"",
+       "test.pbrt:2:15: error: no material named \"nope\""},
+      {"WorldBegin\nMaterial \"plastic\"\nShape \"sphere\"",
+       "test.pbrt:2:1: error: unknown material type \"plastic\""},
       {"Shape \"sphere\"", "test.pbrt:1:1: error: Shape is only allowed after WorldBegin"},
       {"WorldBegin\nCamera \"perspective\"",
-       "test.pbrt:2:1: error: Camera is only allowed before WorldBegin (it sets a rendering option)"},
+       "test.pbrt:2:1: error: Camera is only allowed before WorldBegin (it sets a rendering "
+       "option)"},
       {"WorldBegin\nShape \"plymesh\" \"string filename\" \"x.ply\"",
-       "test.pbrt:2:17: error: cannot read \"x.ply\": file access is disabled when parsing from memory"},
-      {"Include \"other.pbrt\"", "test.pbrt:1:9: error: Include: file access is disabled when parsing from memory"},
-      {"\"float fov\" 3", "test.pbrt:1:1: error: expected a directive (such as Shape or AttributeBegin), got string \"float fov\""},
+       "test.pbrt:2:17: error: cannot read \"x.ply\": file access is disabled when parsing from "
+       "memory"},
+      {"Include \"other.pbrt\"",
+       "test.pbrt:1:9: error: Include: file access is disabled when parsing from memory"},
+      {"\"float fov\" 3",
+       "test.pbrt:1:1: error: expected a directive (such as Shape or AttributeBegin), got string "
+       "\"float fov\""},
       {"WorldBegin\nShape \"sphere\" \"float radius\" 1 \"float radius\" 2",
        "test.pbrt:2:33: error: parameter \"radius\" given twice (first at test.pbrt:2:16)"},
-      {"WorldBegin\nMakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [ \"m\" \"m\" ]",
+      {"WorldBegin\nMakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [ \"m\" "
+       "\"m\" ]",
        "test.pbrt:2:43: error: material \"m\" contains itself (through \"mix\")"},
-      {"LookAt 0 0 0  0 0 0  0 1 0", "test.pbrt:1:1: error: LookAt: the eye and the look-at point are the same"},
-      {"WorldBegin\nLightSource \"sun\"", "test.pbrt:2:1: error: unknown light type \"sun\" (expected point, spot, distant, "
-                                          "infinite, goniometric or projection)"},
-      {"WorldBegin\nObjectInstance \"tree\"", "test.pbrt:2:16: error: ObjectInstance: no object named \"tree\""},
-      {"WorldBegin\nTexture \"t\" \"spectrum\" \"imagemap\"", "test.pbrt:2:1: error: imagemap: \"string filename\" is required"},
+      {"LookAt 0 0 0  0 0 0  0 1 0",
+       "test.pbrt:1:1: error: LookAt: the eye and the look-at point are the same"},
+      {"WorldBegin\nLightSource \"sun\"",
+       "test.pbrt:2:1: error: unknown light type \"sun\" (expected point, spot, distant, "
+       "infinite, goniometric or projection)"},
+      {"WorldBegin\nObjectInstance \"tree\"",
+       "test.pbrt:2:16: error: ObjectInstance: no object named \"tree\""},
+      {"WorldBegin\nTexture \"t\" \"spectrum\" \"imagemap\"",
+       "test.pbrt:2:1: error: imagemap: \"string filename\" is required"},
       {"WorldBegin\nMaterial \"diffuse\" \"texture reflectance\" \"nope\"\nShape \"sphere\"",
        "test.pbrt:2:20: error: \"texture reflectance\": no spectrum texture named \"nope\""},
   };
-  for (const ErrorCase& c : cases) EXPECT_EQ(load_error(c.text), c.expected) << "input:\n" << c.text;
+  for (const ErrorCase& c : cases)
+    EXPECT_EQ(load_error(c.text), c.expected) << "input:\n" << c.text;
 }
 
 TEST(PbrtErrors, PositionsInIncludedFilesNameThatFile) {
   test::TempDir dir;
-  dir.write("inc/bad.pbrt", "AttributeBegin\n  Shape \"sphere\" \"float radius\" [ x ]\nAttributeEnd\n");
+  dir.write("inc/bad.pbrt",
+            "AttributeBegin\n  Shape \"sphere\" \"float radius\" [ x ]\nAttributeEnd\n");
   const std::string main = dir.write("main.pbrt", with_camera("Include \"inc/bad.pbrt\"\n"));
   try {
     load_pbrt(main, test::capture_warning);
@@ -248,13 +271,23 @@ TEST(PbrtWarnings, UnsupportedConstructsWarnOnceWithPosition) {
       "LightSource \"point\"\n");
   test::load_text(text);
   const auto& w = test::captured_warnings();
-  EXPECT_EQ(test::count_containing(w, "test.pbrt:4:1: warning: participating media are not supported; MakeNamedMedium"), 1);
+  EXPECT_EQ(
+      test::count_containing(
+          w, "test.pbrt:4:1: warning: participating media are not supported; MakeNamedMedium"),
+      1);
   EXPECT_EQ(test::count_containing(w, "MakeNamedMedium"), 1);
-  EXPECT_EQ(test::count_containing(w, "test.pbrt:5:1: warning: participating media are not supported; MediumInterface"), 1);
-  EXPECT_EQ(test::count_containing(w, "test.pbrt:7:1: warning: shape \"curve\" is not supported; skipped"), 1);
+  EXPECT_EQ(
+      test::count_containing(
+          w, "test.pbrt:5:1: warning: participating media are not supported; MediumInterface"),
+      1);
+  EXPECT_EQ(test::count_containing(
+                w, "test.pbrt:7:1: warning: shape \"curve\" is not supported; skipped"),
+            1);
   EXPECT_EQ(test::count_containing(w, "curve"), 1);
   EXPECT_EQ(test::count_containing(w, "material \"hair\" is not supported"), 1);
-  EXPECT_EQ(test::count_containing(w, "test.pbrt:10:33: warning: Shape \"sphere\": parameter \"float frobnicate\""), 1);
+  EXPECT_EQ(test::count_containing(
+                w, "test.pbrt:10:33: warning: Shape \"sphere\": parameter \"float frobnicate\""),
+            1);
   EXPECT_EQ(test::count_containing(w, "frobnicate"), 1);
 }
 
@@ -266,8 +299,10 @@ TEST(PbrtDirectives, EveryDirectiveParses) {
       "Accelerator \"bvh\" \"integer maxnodeprims\" 4\n"
       "LookAt 0 0 -5  0 0 0  0 1 0\n"
       "CoordinateSystem \"eye\"\n"
-      "Camera \"perspective\" \"float fov\" 45 \"float lensradius\" 0.01 \"float focaldistance\" 5\n"
-      "Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 16 \"string filename\" \"out.exr\"\n"
+      "Camera \"perspective\" \"float fov\" 45 \"float lensradius\" 0.01 \"float focaldistance\" "
+      "5\n"
+      "Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 16 \"string filename\" "
+      "\"out.exr\"\n"
       "Sampler \"zsobol\" \"integer pixelsamples\" 8\n"
       "Integrator \"bdpt\" \"integer maxdepth\" 7\n"
       "PixelFilter \"gaussian\"\n"
@@ -285,27 +320,33 @@ TEST(PbrtDirectives, EveryDirectiveParses) {
       "  Texture \"f\" \"float\" \"constant\" \"float value\" 0.1\n"
       "  Texture \"s\" \"spectrum\" \"scale\" \"texture tex\" \"c\" \"float scale\" 2\n"
       "  Texture \"k\" \"spectrum\" \"checkerboard\" \"texture tex1\" \"c\"\n"
-      "  Texture \"m\" \"spectrum\" \"mix\" \"texture tex1\" \"c\" \"texture tex2\" \"k\" \"float amount\" 0.3\n"
+      "  Texture \"m\" \"spectrum\" \"mix\" \"texture tex1\" \"c\" \"texture tex2\" \"k\" \"float "
+      "amount\" 0.3\n"
       "  MakeNamedMaterial \"a\" \"string type\" \"diffuse\" \"texture reflectance\" \"m\"\n"
-      "  MakeNamedMaterial \"b\" \"string type\" \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\""
+      "  MakeNamedMaterial \"b\" \"string type\" \"conductor\" \"spectrum eta\" \"metal-Au-eta\" "
+      "\"spectrum k\" \"metal-Au-k\""
       " \"texture roughness\" \"f\"\n"
-      "  MakeNamedMaterial \"ab\" \"string type\" \"mix\" \"string materials\" [\"a\" \"b\"] \"float amount\" 0.5\n"
+      "  MakeNamedMaterial \"ab\" \"string type\" \"mix\" \"string materials\" [\"a\" \"b\"] "
+      "\"float amount\" 0.5\n"
       "  NamedMaterial \"ab\"\n"
       "  Shape \"sphere\"\n"
       "  Material \"dielectric\" \"spectrum eta\" \"glass-BK7\" \"float roughness\" 0.1\n"
       "  Shape \"disk\" \"float radius\" 2\n"
       "  Material \"thindielectric\" \"float eta\" 1.4\n"
       "  Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n"
-      "  Material \"coateddiffuse\" \"rgb reflectance\" [0.2 0.3 0.4] \"float roughness\" 0.1 \"float thickness\" 0.02\n"
+      "  Material \"coateddiffuse\" \"rgb reflectance\" [0.2 0.3 0.4] \"float roughness\" 0.1 "
+      "\"float thickness\" 0.02\n"
       "  Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
       "  Material \"diffusetransmission\" \"rgb transmittance\" [0.5 0.5 0.5]\n"
       "  Material \"interface\"\n"
       "  Shape \"sphere\"\n"
       "AttributeEnd\n"
-      "ObjectBegin \"thing\"\n  Material \"diffuse\"\n  Shape \"sphere\" \"float radius\" 0.1\nObjectEnd\n"
+      "ObjectBegin \"thing\"\n  Material \"diffuse\"\n  Shape \"sphere\" \"float radius\" "
+      "0.1\nObjectEnd\n"
       "AttributeBegin\n  Translate 0 3 0\n  ObjectInstance \"thing\"\nAttributeEnd\n"
       "AttributeBegin\n"
-      "  AreaLightSource \"diffuse\" \"blackbody L\" 3000 \"float scale\" 2 \"bool twosided\" true\n"
+      "  AreaLightSource \"diffuse\" \"blackbody L\" 3000 \"float scale\" 2 \"bool twosided\" "
+      "true\n"
       "  Shape \"trianglemesh\" \"point3 P\" [0 0 3 1 0 3 0 1 3] \"integer indices\" [0 1 2]\n"
       "AttributeEnd\n"
       "LightSource \"point\" \"point3 from\" [0 5 0] \"rgb I\" [1 1 1]\n"

@@ -22,12 +22,17 @@ void put(std::string* out, T v, bool big_endian) {
 
 // A unit quad (as one quad face) plus a triangle, with normals and uv.
 std::string binary_ply(bool big_endian) {
-  std::string s = std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
-                  " 1.0\ncomment test\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
-                  "property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n"
-                  "element face 2\nproperty list uint8 int vertex_indices\nend_header\n";
-  const float v[5][8] = {{0, 0, 0, 0, 0, 1, 0, 0}, {1, 0, 0, 0, 0, 1, 1, 0}, {1, 1, 0, 0, 0, 1, 1, 1},
-                         {0, 1, 0, 0, 0, 1, 0, 1}, {2, 0, 0, 0, 0, 1, 0.5f, 0.5f}};
+  std::string s =
+      std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
+      " 1.0\ncomment test\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float "
+      "v\n"
+      "element face 2\nproperty list uint8 int vertex_indices\nend_header\n";
+  const float v[5][8] = {{0, 0, 0, 0, 0, 1, 0, 0},
+                         {1, 0, 0, 0, 0, 1, 1, 0},
+                         {1, 1, 0, 0, 0, 1, 1, 1},
+                         {0, 1, 0, 0, 0, 1, 0, 1},
+                         {2, 0, 0, 0, 0, 1, 0.5f, 0.5f}};
   for (const auto& row : v)
     for (float f : row) put(&s, f, big_endian);
   put<uint8_t>(&s, 4, big_endian);
@@ -53,8 +58,10 @@ TEST(PbrtPly, BinaryLittleAndBigEndian) {
 
 TEST(PbrtPly, AsciiWithStAndExtraElements) {
   const PlyMesh m = parse_ply(
-      "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
-      "property float s\nproperty float t\nproperty uchar red\nelement material 1\nproperty int id\n"
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty "
+      "double z\n"
+      "property float s\nproperty float t\nproperty uchar red\nelement material 1\nproperty int "
+      "id\n"
       "element face 1\nproperty list uchar uint vertex_index\nproperty int flags\nend_header\n"
       "0 0 0 0 0 255\n1 0 0 1 0 255\n0 1 0 0 1 255\n7\n3 0 1 2 9\n");
   EXPECT_EQ(m.positions.size(), 3u);
@@ -65,7 +72,8 @@ TEST(PbrtPly, AsciiWithStAndExtraElements) {
 
 TEST(PbrtPly, SkipsPolygonsWithMoreThanFourVertices) {
   const PlyMesh m = parse_ply(
-      "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+      "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float "
+      "z\n"
       "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
       "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 2 0\n5 0 1 2 4 3\n3 0 1 2\n");
   EXPECT_EQ(m.indices.size(), 3u);
@@ -76,12 +84,17 @@ TEST(PbrtPly, MalformedFilesFailWithAReason) {
   const char* bad[] = {
       "plx\n",
       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n",  // no y, z
-      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n",
-      "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty float x\nproperty float y\n"
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float "
+      "z\nend_header\n0 0 0\n",
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty float x\nproperty "
+      "float y\n"
       "property float z\nend_header\n",
-      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n",
-      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n",
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float "
+      "z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 "
+      "0 1 7\n",
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float "
+      "z\n",
   };
   for (const char* text : bad) EXPECT_THROW(parse_ply(text), std::runtime_error) << text;
 }
@@ -98,7 +111,8 @@ TEST(PbrtPly, PlymeshShapeLoadsRelativeToTheSceneFile) {
 TEST(PbrtPly, PlymeshErrorsPointAtTheFilename) {
   test::TempDir dir;
   dir.write("bad.ply", "ply\nformat ascii 1.0\nelement vertex 1\n");
-  const std::string main = dir.write("s.pbrt", test::with_camera("Shape \"plymesh\"\n  \"string filename\" \"bad.ply\"\n"));
+  const std::string main = dir.write(
+      "s.pbrt", test::with_camera("Shape \"plymesh\"\n  \"string filename\" \"bad.ply\"\n"));
   try {
     load_pbrt(main, test::capture_warning);
     FAIL();

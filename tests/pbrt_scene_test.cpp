@@ -21,8 +21,8 @@ using test::with_camera;
 
 std::string camera_block(const std::string& before_camera, int w, int h, float fov) {
   return before_camera + "\nCamera \"perspective\" \"float fov\" " + std::to_string(fov) +
-         "\nFilm \"rgb\" \"integer xresolution\" " + std::to_string(w) + " \"integer yresolution\" " +
-         std::to_string(h) + "\nWorldBegin\n";
+         "\nFilm \"rgb\" \"integer xresolution\" " + std::to_string(w) +
+         " \"integer yresolution\" " + std::to_string(h) + "\nWorldBegin\n";
 }
 
 void expect_raster(const Scene& scene, Vec3 p, float x, float y) {
@@ -37,7 +37,7 @@ void expect_raster(const Scene& scene, Vec3 p, float x, float y) {
 TEST(PbrtCamera, LookAtProjectsAsPbrtV4) {
   auto scene = load_text(camera_block("LookAt 0 0 -5  0 0 0  0 1 0", 100, 100, 90));
   expect_raster(*scene, {0, 0, 0}, 50, 50);
-  expect_raster(*scene, {1, 0, 0}, 60, 50);   // tan(45) = 1: screen x = 1/5
+  expect_raster(*scene, {1, 0, 0}, 60, 50);  // tan(45) = 1: screen x = 1/5
   expect_raster(*scene, {0, 1, 0}, 50, 40);
 }
 
@@ -55,23 +55,25 @@ TEST(PbrtCamera, LookingDownMinusZPutsWorldXOnTheLeft) {
 
 TEST(PbrtCamera, FovSpansTheShorterAxis) {
   auto wide = load_text(camera_block("LookAt 0 0 -5  0 0 0  0 1 0", 200, 100, 90));
-  expect_raster(*wide, {0, 1, 0}, 100, 40);   // vertical: 100 px for screen [-1, 1]
-  expect_raster(*wide, {1, 0, 0}, 110, 50);   // horizontal: 200 px for [-2, 2]
+  expect_raster(*wide, {0, 1, 0}, 100, 40);  // vertical: 100 px for screen [-1, 1]
+  expect_raster(*wide, {1, 0, 0}, 110, 50);  // horizontal: 200 px for [-2, 2]
   auto tall = load_text(camera_block("LookAt 0 0 -5  0 0 0  0 1 0", 100, 200, 90));
-  expect_raster(*tall, {1, 0, 0}, 60, 100);   // horizontal is the shorter axis now
-  expect_raster(*tall, {0, 1, 0}, 50, 90);    // vertical: 200 px for [-2, 2]
+  expect_raster(*tall, {1, 0, 0}, 60, 100);  // horizontal is the shorter axis now
+  expect_raster(*tall, {0, 1, 0}, 50, 90);   // vertical: 200 px for [-2, 2]
 }
 
 TEST(PbrtCamera, TransformMatrixIsWorldToCamera) {
   // Column-major world-to-camera: translate by (0, 0, 5), so the camera sits at z = -5.
-  auto scene = load_text(camera_block("Transform [1 0 0 0  0 1 0 0  0 0 1 0  0 0 5 1]", 100, 100, 90));
+  auto scene =
+      load_text(camera_block("Transform [1 0 0 0  0 1 0 0  0 0 1 0  0 0 5 1]", 100, 100, 90));
   EXPECT_NEAR(scene->camera().position().z, -5, 1e-5f);
   expect_raster(*scene, {1, 0, 0}, 60, 50);
 }
 
 TEST(PbrtCamera, ThinLensParameters) {
   auto scene = load_text(
-      "LookAt 0 0 -5 0 0 0 0 1 0\nCamera \"perspective\" \"float lensradius\" 0.1 \"float focaldistance\" 5\nWorldBegin\n");
+      "LookAt 0 0 -5 0 0 0 0 1 0\nCamera \"perspective\" \"float lensradius\" 0.1 \"float "
+      "focaldistance\" 5\nWorldBegin\n");
   EXPECT_FALSE(scene->camera().is_pinhole());
   EXPECT_NEAR(scene->camera().lens_area(), kPi * 0.01f, 1e-6f);
   EXPECT_EQ(scene->camera().width(), 1280);  // pbrt-v4's default film
@@ -79,8 +81,9 @@ TEST(PbrtCamera, ThinLensParameters) {
 }
 
 TEST(PbrtCamera, NamedCameraCoordinateSystem) {
-  auto scene = load_text(camera_block("LookAt 0 0 -5  0 0 0  0 1 0", 64, 64, 90) +
-                         "CoordSysTransform \"camera\"\nTranslate 0 0 2\nShape \"sphere\" \"float radius\" 0.5\n");
+  auto scene = load_text(
+      camera_block("LookAt 0 0 -5  0 0 0  0 1 0", 64, 64, 90) +
+      "CoordSysTransform \"camera\"\nTranslate 0 0 2\nShape \"sphere\" \"float radius\" 0.5\n");
   SurfaceInteraction si;
   ASSERT_TRUE(scene->intersect({{0, 0, -10}, {0, 0, 1}, kInfinity}, &si));
   EXPECT_NEAR(si.p.z, -3.5f, 1e-4f);
@@ -94,22 +97,25 @@ SurfaceInteraction hit(const Scene& scene, Vec3 o, Vec3 d) {
 
 TEST(PbrtTransforms, ComposeAsPbrtPostMultiplies) {
   // Translate then Rotate: the sphere is rotated about its own origin, then moved.
-  auto scene = load_text(with_camera("AttributeBegin\nTranslate 0 0 10\nRotate 90 0 1 0\nScale 2 2 2\n"
-                                     "Shape \"sphere\" \"float radius\" 1\nAttributeEnd\n"));
+  auto scene =
+      load_text(with_camera("AttributeBegin\nTranslate 0 0 10\nRotate 90 0 1 0\nScale 2 2 2\n"
+                            "Shape \"sphere\" \"float radius\" 1\nAttributeEnd\n"));
   const SurfaceInteraction si = hit(*scene, {0, 0, 0}, {0, 0, 1});
   EXPECT_NEAR(si.p.z, 8, 1e-4f);
   EXPECT_EQ(scene->sphere_count(), 1u);
 }
 
 TEST(PbrtTransforms, AttributeEndRestoresTransformAndMaterial) {
-  auto scene = load_text(with_camera("AttributeBegin\nTranslate 100 0 0\nAttributeEnd\n"
-                                     "Translate 0 0 10\nShape \"sphere\"\n"));
+  auto scene =
+      load_text(with_camera("AttributeBegin\nTranslate 100 0 0\nAttributeEnd\n"
+                            "Translate 0 0 10\nShape \"sphere\"\n"));
   EXPECT_NEAR(hit(*scene, {0, 0, 0}, {0, 0, 1}).p.z, 9, 1e-4f);
 }
 
 TEST(PbrtTransforms, TransformBeginEndRestoreOnlyTheTransform) {
-  auto scene = load_text(with_camera("TransformBegin\nTranslate 100 0 0\nTransformEnd\n"
-                                     "Translate 0 0 10\nShape \"sphere\"\n"));
+  auto scene =
+      load_text(with_camera("TransformBegin\nTranslate 100 0 0\nTransformEnd\n"
+                            "Translate 0 0 10\nShape \"sphere\"\n"));
   EXPECT_NEAR(hit(*scene, {0, 0, 0}, {0, 0, 1}).p.z, 9, 1e-4f);
 }
 
@@ -141,14 +147,17 @@ TEST(PbrtShapes, DiskNormalIsPlusZ) {
 TEST(PbrtShapes, ReverseOrientationFlipsTriangleNormals) {
   const std::string tri = "Shape \"trianglemesh\" \"point3 P\" [-1 -1 0  1 -1 0  0 1 0]\n";
   EXPECT_GT(hit(*load_text(with_camera(tri)), {0, 0, 5}, {0, 0, -1}).ng.z, 0.99f);
-  EXPECT_LT(hit(*load_text(with_camera("ReverseOrientation\n" + tri)), {0, 0, 5}, {0, 0, -1}).ng.z, -0.99f);
+  EXPECT_LT(hit(*load_text(with_camera("ReverseOrientation\n" + tri)), {0, 0, 5}, {0, 0, -1}).ng.z,
+            -0.99f);
   // A mirroring transform keeps the object-space side (pbrt-v4 compensates the winding).
-  EXPECT_LT(hit(*load_text(with_camera("Scale 1 1 -1\n" + tri)), {0, 0, 5}, {0, 0, -1}).ng.z, -0.99f);
+  EXPECT_LT(hit(*load_text(with_camera("Scale 1 1 -1\n" + tri)), {0, 0, 5}, {0, 0, -1}).ng.z,
+            -0.99f);
 }
 
 TEST(PbrtShapes, BilinearMeshIsTwoTrianglesPerPatch) {
-  auto scene = load_text(with_camera(
-      "Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0] \"point2 uv\" [0 0 1 0 0 1 1 1]\n"));
+  auto scene =
+      load_text(with_camera("Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0] "
+                            "\"point2 uv\" [0 0 1 0 0 1 1 1]\n"));
   EXPECT_EQ(scene->triangle_count(), 2u);
   const SurfaceInteraction si = hit(*scene, {0.8f, 0.7f, 1}, {0, 0, -1});
   EXPECT_GT(si.ng.z, 0.99f);  // cross(p10 - p00, p01 - p00)
@@ -157,9 +166,10 @@ TEST(PbrtShapes, BilinearMeshIsTwoTrianglesPerPatch) {
 }
 
 TEST(PbrtLights, AreaLightIsOneSidedOnTheWindingSide) {
-  auto scene = load_text(with_camera(
-      "AreaLightSource \"diffuse\" \"rgb L\" [17 12 4]\n"
-      "Shape \"trianglemesh\" \"point3 P\" [-1 -1 0  1 -1 0  0 1 0] \"integer indices\" [0 1 2]\n"));
+  auto scene =
+      load_text(with_camera("AreaLightSource \"diffuse\" \"rgb L\" [17 12 4]\n"
+                            "Shape \"trianglemesh\" \"point3 P\" [-1 -1 0  1 -1 0  0 1 0] "
+                            "\"integer indices\" [0 1 2]\n"));
   ASSERT_EQ(scene->lights().size(), 1u);
   const SurfaceInteraction si = hit(*scene, {0, 0, 5}, {0, 0, -1});
   ASSERT_NE(si.area_light, nullptr);
@@ -183,15 +193,16 @@ TEST(PbrtLights, TwoSidedAndScale) {
 
 TEST(PbrtLights, PowerNormalisesEachTriangle) {
   // Area 2, one-sided: L = P / (pi A).
-  auto scene = load_text(with_camera(
-      "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1] \"float power\" 10\n"
-      "Shape \"trianglemesh\" \"point3 P\" [-1 -1 0  1 -1 0  1 1 0]\n"));
+  auto scene =
+      load_text(with_camera("AreaLightSource \"diffuse\" \"rgb L\" [1 1 1] \"float power\" 10\n"
+                            "Shape \"trianglemesh\" \"point3 P\" [-1 -1 0  1 -1 0  1 1 0]\n"));
   const SurfaceInteraction si = hit(*scene, {0.5f, -0.5f, 5}, {0, 0, -1});
   EXPECT_NEAR(si.area_light->radiance(si.p, si.ng, si.uv, {0, 0, 1}).g, 10 / (kPi * 2), 1e-4f);
 }
 
 TEST(PbrtLights, BlackbodyHasLuminanceOne) {
-  for (float t : {2700.f, 6500.f, 10000.f}) EXPECT_NEAR(pbrt::blackbody_rgb(t).luminance(), 1, 0.02f) << t;
+  for (float t : {2700.f, 6500.f, 10000.f})
+    EXPECT_NEAR(pbrt::blackbody_rgb(t).luminance(), 1, 0.02f) << t;
   const Rgb warm = pbrt::blackbody_rgb(2700);
   EXPECT_GT(warm.r, warm.b);
   const Rgb d65ish = pbrt::blackbody_rgb(6504);
@@ -221,25 +232,30 @@ TEST(PbrtTextures, ImageMapRelativeToTheSceneFileAndLinearForNonPng) {
   pfm.append(reinterpret_cast<const char*>(px), sizeof(px));
   dir.write("tex/t.pfm", pfm);
   const std::string main = dir.write(
-      "s.pbrt", with_camera("Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"tex/t.pfm\" \"float uscale\" 2\n"
-                            "Material \"diffuse\" \"texture reflectance\" \"t\"\n"
-                            "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"point2 uv\" [0 0 1 0 0 1]\n"));
+      "s.pbrt",
+      with_camera(
+          "Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"tex/t.pfm\" \"float "
+          "uscale\" 2\n"
+          "Material \"diffuse\" \"texture reflectance\" \"t\"\n"
+          "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"point2 uv\" [0 0 1 0 0 1]\n"));
   EXPECT_NO_THROW(load_pbrt(main, test::capture_warning));
 }
 
 TEST(PbrtInstancing, ObjectInstancesAreFlattenedCopies) {
-  auto scene = load_text(with_camera(
-      "ObjectBegin \"tri\"\nTranslate 0 0 1\n"
-      "Shape \"trianglemesh\" \"point3 P\" [-1 -1 0  1 -1 0  0 1 0]\nObjectEnd\n"
-      "AttributeBegin\nTranslate 0 0 5\nObjectInstance \"tri\"\nAttributeEnd\n"
-      "AttributeBegin\nTranslate 10 0 5\nObjectInstance \"tri\"\nAttributeEnd\n"));
+  auto scene = load_text(
+      with_camera("ObjectBegin \"tri\"\nTranslate 0 0 1\n"
+                  "Shape \"trianglemesh\" \"point3 P\" [-1 -1 0  1 -1 0  0 1 0]\nObjectEnd\n"
+                  "AttributeBegin\nTranslate 0 0 5\nObjectInstance \"tri\"\nAttributeEnd\n"
+                  "AttributeBegin\nTranslate 10 0 5\nObjectInstance \"tri\"\nAttributeEnd\n"));
   EXPECT_EQ(scene->triangle_count(), 2u);
   EXPECT_NEAR(hit(*scene, {0, 0, 0}, {0, 0, 1}).p.z, 6, 1e-5f);
 }
 
 // --- The shared scenes ---------------------------------------------------------------
 
-std::string shared(const std::string& rel) { return std::string(CAUSTICA_SHARED_SCENES) + "/" + rel; }
+std::string shared(const std::string& rel) {
+  return std::string(CAUSTICA_SHARED_SCENES) + "/" + rel;
+}
 
 TEST(PbrtSharedScenes, CornellCausticsLoadsAndProjectsLikePbrtV4) {
   test::captured_warnings().clear();
@@ -267,7 +283,8 @@ TEST(PbrtSharedScenes, CornellCausticsLoadsAndProjectsLikePbrtV4) {
 }
 
 TEST(PbrtSharedScenes, EveryOwnSceneLoads) {
-  for (const char* name : {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic", "mis-plates"}) {
+  for (const char* name :
+       {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic", "mis-plates"}) {
     SCOPED_TRACE(name);
     test::captured_warnings().clear();
     std::unique_ptr<Scene> scene;
@@ -294,9 +311,11 @@ TEST(PbrtSharedScenes, EveryThirdPartySceneLoads) {
       ADD_FAILURE() << e.what();
       continue;
     }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("%-24s %8zu triangles %3zu spheres %6zu lights  %.3f s\n", entry.path().filename().c_str(),
-                scene->triangle_count(), scene->sphere_count(), scene->lights().size(), seconds);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf("%-24s %8zu triangles %3zu spheres %6zu lights  %.3f s\n",
+                entry.path().filename().c_str(), scene->triangle_count(), scene->sphere_count(),
+                scene->lights().size(), seconds);
     for (const std::string& w : test::captured_warnings()) std::printf("  %s\n", w.c_str());
     EXPECT_GT(scene->lights().size(), 0u);
     EXPECT_GT(scene->triangle_count(), 0u);
@@ -308,7 +327,8 @@ TEST(PbrtSharedScenes, EveryThirdPartySceneLoads) {
 // One sample per pixel with pt and a short path: every own scene renders to a finite,
 // lit image (the loader produced something an integrator can use).
 TEST(PbrtSharedScenes, OwnScenesRenderWithPt) {
-  for (const char* name : {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic", "mis-plates"}) {
+  for (const char* name :
+       {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic", "mis-plates"}) {
     SCOPED_TRACE(name);
     auto scene = load_pbrt(shared(std::string(name) + ".pbrt"), test::capture_warning);
     IntegratorSettings settings;

@@ -29,7 +29,8 @@ inline int count_containing(const std::vector<std::string>& lines, const std::st
 // A minimal valid options block, so world-block snippets can be tested on their own.
 inline std::string with_camera(const std::string& world) {
   return "Film \"rgb\" \"integer xresolution\" [ 64 ] \"integer yresolution\" [ 64 ]\n"
-         "Camera \"perspective\"\nWorldBegin\n" + world;
+         "Camera \"perspective\"\nWorldBegin\n" +
+         world;
 }
 
 inline std::unique_ptr<Scene> load_text(const std::string& text) {
@@ -52,8 +53,9 @@ class TempDir {
  public:
   TempDir() {
     path_ = std::filesystem::temp_directory_path() /
-            ("caustica_pbrt_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-             std::to_string(counter()++) + "_" + std::to_string(reinterpret_cast<uintptr_t>(this)));
+            ("caustica_pbrt_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+             "_" + std::to_string(counter()++) + "_" +
+             std::to_string(reinterpret_cast<uintptr_t>(this)));
     std::filesystem::create_directories(path_);
   }
   ~TempDir() {

@@ -40,11 +40,11 @@ constexpr float kDefaultRadiusFactor = 0.003f;
 
 // Which techniques take part (tech. rep. section 6, SmallVCM's switches).
 struct Techniques {
-  bool light_to_camera = false;   // t = 1 splats
-  bool connect = false;           // NEE, emitter hits and connections, MIS-weighted
-  bool merge = false;             // vertex merging
-  bool camera_stops = false;      // camera subpaths end at their first non-delta vertex
-  bool unweighted = false;        // single-technique estimators (lt, ppm): all weights 1
+  bool light_to_camera = false;  // t = 1 splats
+  bool connect = false;          // NEE, emitter hits and connections, MIS-weighted
+  bool merge = false;            // vertex merging
+  bool camera_stops = false;     // camera subpaths end at their first non-delta vertex
+  bool unweighted = false;       // single-technique estimators (lt, ppm): all weights 1
 };
 
 Techniques techniques_of(BidirAlgorithm a) {
@@ -71,11 +71,16 @@ Techniques techniques_of(BidirAlgorithm a) {
 
 const char* name_of(BidirAlgorithm a) {
   switch (a) {
-    case BidirAlgorithm::LightTracing: return "lt";
-    case BidirAlgorithm::Bpt: return "bpt";
-    case BidirAlgorithm::Ppm: return "ppm";
-    case BidirAlgorithm::Bpm: return "bpm";
-    case BidirAlgorithm::Vcm: return "vcm";
+    case BidirAlgorithm::LightTracing:
+      return "lt";
+    case BidirAlgorithm::Bpt:
+      return "bpt";
+    case BidirAlgorithm::Ppm:
+      return "ppm";
+    case BidirAlgorithm::Bpm:
+      return "bpm";
+    case BidirAlgorithm::Vcm:
+      return "vcm";
   }
   return "?";
 }
@@ -87,7 +92,8 @@ class TechniqueImages {
  public:
   static constexpr int kMaxVertices = 64;
   static uint32_t key(bool merge, int s, int t) {
-    return (merge ? kMaxVertices * kMaxVertices : 0) + uint32_t(std::min(s, kMaxVertices - 1)) * kMaxVertices +
+    return (merge ? kMaxVertices * kMaxVertices : 0) +
+           uint32_t(std::min(s, kMaxVertices - 1)) * kMaxVertices +
            uint32_t(std::min(t, kMaxVertices - 1));
   }
   void reset(int width, int height) {
@@ -120,8 +126,9 @@ class TechniqueImages {
       for (Rgb& p : out.pixels()) p *= scale;
       const bool merge = k >= uint32_t(kMaxVertices * kMaxVertices);
       const uint32_t rest = k % (kMaxVertices * kMaxVertices);
-      const std::string name = std::string(merge ? "merge_" : "connect_") + "s" + std::to_string(rest / kMaxVertices) +
-                               "_t" + std::to_string(rest % kMaxVertices) + ".exr";
+      const std::string name = std::string(merge ? "merge_" : "connect_") + "s" +
+                               std::to_string(rest / kMaxVertices) + "_t" +
+                               std::to_string(rest % kMaxVertices) + ".exr";
       write_exr(out, (std::filesystem::path(dir) / name).string());
       files.push_back(name);
     }
@@ -195,7 +202,8 @@ class BidirIntegrator final : public Integrator {
     Vec3 center;
     float scene_radius;
     scene.bounds().bounding_sphere(&center, &scene_radius);
-    base_radius_ = settings_.radius > 0 ? settings_.radius : kDefaultRadiusFactor * std::max(scene_radius, 1e-3f);
+    base_radius_ = settings_.radius > 0 ? settings_.radius
+                                        : kDefaultRadiusFactor * std::max(scene_radius, 1e-3f);
     codec_ = PositionCodec(scene.bounds().lo, scene.bounds().hi);
     light_paths_ = settings_.light_paths > 0 ? settings_.light_paths : film.pixel_count();
     if (!settings_.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
@@ -208,8 +216,11 @@ class BidirIntegrator final : public Integrator {
     Iteration it;
     it.index = iteration;
     // r_i = r_1 * i^((alpha - 1) / 2), i 1-based (Knaus & Zwicker 2011; Georgiev et al. 2012).
-    it.radius = std::max(base_radius_ * std::pow(float(iteration + 1), 0.5f * (settings_.radius_alpha - 1.f)), 1e-7f);
-    it.rules = MisRules(heuristic_, tech_.connect || tech_.light_to_camera, tech_.merge, float(light_paths_), it.radius);
+    it.radius = std::max(
+        base_radius_ * std::pow(float(iteration + 1), 0.5f * (settings_.radius_alpha - 1.f)),
+        1e-7f);
+    it.rules = MisRules(heuristic_, tech_.connect || tech_.light_to_camera, tech_.merge,
+                        float(light_paths_), it.radius);
     it.merge_normalization = 1.f / (kPi * it.radius * it.radius * float(light_paths_));
 
     trace_light_paths(scene, it, film);
@@ -219,11 +230,13 @@ class BidirIntegrator final : public Integrator {
     ++iterations_;
     last_radius_ = it.radius;
     vertices_total_ += vertices_.size();
-    seconds_total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    seconds_total_ +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
   void finish(const Scene&, Film& film) override {
-    if (techniques_.enabled()) technique_files_ = techniques_.write(settings_.techniques_dir, film.iterations());
+    if (techniques_.enabled())
+      technique_files_ = techniques_.write(settings_.techniques_dir, film.iterations());
   }
 
   void report(nlohmann::json& stats) const override {
@@ -255,7 +268,8 @@ class BidirIntegrator final : public Integrator {
       chunk.path_ends.clear();
       chunk.splats.clear();
       chunk.nonfinite = 0;
-      const uint64_t first = c * kChunkPaths, last = std::min<uint64_t>(first + kChunkPaths, light_paths_);
+      const uint64_t first = c * kChunkPaths,
+                     last = std::min<uint64_t>(first + kChunkPaths, light_paths_);
       for (uint64_t path = first; path < last; ++path) {
         arena.reset();
         trace_light_path(scene, it, path, chunk, arena);
@@ -339,18 +353,21 @@ class BidirIntegrator final : public Integrator {
 
       if (!bsdf.is_delta()) {
         if (stores_vertices()) {
-          chunk.vertices.push_back(
-              bidir::pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}, codec_));
+          chunk.vertices.push_back(bidir::pack_light_vertex(
+              {si.p, si.wo, scene.primitive_index(si), depth, beta, mis}, codec_));
         }
-        if (tech_.light_to_camera) connect_to_camera(scene, it, si, bsdf, beta, mis, depth, rng, chunk);
+        if (tech_.light_to_camera)
+          connect_to_camera(scene, it, si, bsdf, beta, mis, depth, rng, chunk);
       }
       if (depth + 1 > max_depth) break;
 
       const float uc = rng.next_float();
       const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Importance);
       if (!bs) break;
-      const float pdf_fwd = bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Importance) : bs->pdf;
-      bidir::scatter_update(it.rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Importance, bs->is_specular(), pdf_fwd);
+      const float pdf_fwd =
+          bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Importance) : bs->pdf;
+      bidir::scatter_update(it.rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Importance,
+                            bs->is_specular(), pdf_fwd);
       beta *= bs->f * (bsdf.abs_cos(bs->wi) / bs->pdf);
       if (beta.is_black()) break;
       ray = si.spawn_ray(bs->wi);
@@ -366,17 +383,20 @@ class BidirIntegrator final : public Integrator {
   }
 
   // t = 1: the light vertex seen through a lens point; splat recorded in the chunk.
-  void connect_to_camera(const Scene& scene, const Iteration& it, const SurfaceInteraction& si, const Bsdf& bsdf,
-                         Rgb beta, const MisSums& mis, int depth, Pcg32& rng, LightChunk& chunk) const {
+  void connect_to_camera(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
+                         const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth, Pcg32& rng,
+                         LightChunk& chunk) const {
     const Camera& camera = scene.camera();
     const auto cs = camera.sample_wi(si.p, rng.next_2d());
     if (!cs || !(cs->importance > 0)) return;
     const Rgb f = bsdf.f(si.wo, cs->wi, TransportMode::Importance) * bsdf.abs_cos(cs->wi);
     if (f.is_black()) return;
     // Pixel importance is pixel_count * We; each pixel is estimated by N light paths.
-    const float scale = cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(light_paths_));
-    const float w =
-        tech_.unweighted ? 1.f : bidir::weight_light_to_camera(it.rules, camera, si, bsdf, si.wo, mis, cs->p_lens);
+    const float scale =
+        cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(light_paths_));
+    const float w = tech_.unweighted ? 1.f
+                                     : bidir::weight_light_to_camera(it.rules, camera, si, bsdf,
+                                                                     si.wo, mis, cs->p_lens);
     const Rgb value = beta * f * (scale * w);
     if (value.is_black()) return;
     if (!value.is_finite()) {
@@ -384,8 +404,10 @@ class BidirIntegrator final : public Integrator {
       return;
     }
     if (scene.occluded(si.spawn_ray_to(cs->p_lens))) return;
-    const int x = std::min(int(cs->raster.x), camera.width() - 1), y = std::min(int(cs->raster.y), camera.height() - 1);
-    chunk.splats.push_back({uint32_t(y * camera.width() + x), TechniqueImages::key(false, depth + 1, 1), value});
+    const int x = std::min(int(cs->raster.x), camera.width() - 1),
+              y = std::min(int(cs->raster.y), camera.height() - 1);
+    chunk.splats.push_back(
+        {uint32_t(y * camera.width() + x), TechniqueImages::key(false, depth + 1, 1), value});
   }
 
   // ---- camera subpaths ----------------------------------------------------------------------
@@ -421,12 +443,13 @@ class BidirIntegrator final : public Integrator {
     if (!(pdf_camera > 0)) return;
     MisSums mis = it.rules.camera_start(pdf_camera);
     const int max_depth = settings_.max_depth;
-    const uint64_t light_path = pixel % light_paths_;  // the light subpath this camera path connects to
+    const uint64_t light_path =
+        pixel % light_paths_;  // the light subpath this camera path connects to
 
     Rgb beta(1.f);
     Vec3 prev_p = ray.o;
-    int depth = 0;               // surface vertices so far
-    bool specular_path = true;   // every bounce so far was specular
+    int depth = 0;              // surface vertices so far
+    bool specular_path = true;  // every bounce so far was specular
     float segment = 0;
     float eta_scale = 1;
     // Emitters: MIS-weighted when connections take part, else only via delta-only chains.
@@ -484,8 +507,10 @@ class BidirIntegrator final : public Integrator {
       // PPM / lt: the non-delta part of this vertex was estimated by merging (or belongs to light
       // tracing); only its delta lobes carry the camera path on.
       if (tech_.camera_stops && !delta && !bs->is_specular()) break;
-      const float pdf_fwd = bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Radiance) : bs->pdf;
-      bidir::scatter_update(it.rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Radiance, bs->is_specular(), pdf_fwd);
+      const float pdf_fwd =
+          bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Radiance) : bs->pdf;
+      bidir::scatter_update(it.rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Radiance,
+                            bs->is_specular(), pdf_fwd);
       beta *= bs->f * (bsdf.abs_cos(bs->wi) / bs->pdf);
       specular_path = specular_path && bs->is_specular();
       if (bs->is_transmission()) eta_scale *= sqr(bs->eta);
@@ -502,8 +527,9 @@ class BidirIntegrator final : public Integrator {
     }
   }
 
-  void next_event(const Scene& scene, const Iteration& it, const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
-                  const MisSums& mis, int depth, Pcg32& rng, PixelAccumulator& acc) const {
+  void next_event(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
+                  const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth, Pcg32& rng,
+                  PixelAccumulator& acc) const {
     const LightSampler& lights = scene.light_sampler();
     float pmf;
     const Light* light = lights.sample(rng.next_float(), &pmf);
@@ -516,13 +542,15 @@ class BidirIntegrator final : public Integrator {
     const float w = bidir::weight_next_event(it.rules, *light, pmf, *ls, si, bsdf, mis);
     const Rgb value = beta * f * ls->radiance * (w / (pmf * ls->pdf_w));
     if (value.is_black()) return;
-    const Ray shadow = std::isinf(ls->distance) ? si.spawn_ray(ls->wi) : si.spawn_ray_to(ls->p_light);
+    const Ray shadow =
+        std::isinf(ls->distance) ? si.spawn_ray(ls->wi) : si.spawn_ray_to(ls->p_light);
     if (scene.occluded(shadow)) return;
     acc.add(false, 1, depth + 1, value);
   }
 
-  void connect_to_light_path(const Scene& scene, const Iteration& it, const SurfaceInteraction& si, const Bsdf& bsdf,
-                             Rgb beta, const MisSums& mis, int depth, uint64_t light_path, ScratchArena& arena,
+  void connect_to_light_path(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
+                             const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth,
+                             uint64_t light_path, ScratchArena& arena,
                              PixelAccumulator& acc) const {
     for (uint32_t i = path_begin_[light_path]; i < path_begin_[light_path + 1]; ++i) {
       const LightVertex& stored = vertices_[i];
@@ -538,9 +566,11 @@ class BidirIntegrator final : public Integrator {
       const Vec3 dir = d / std::sqrt(dist2);
       const Rgb f_camera = bsdf.f(si.wo, dir, TransportMode::Radiance) * bsdf.abs_cos(dir);
       if (f_camera.is_black()) continue;
-      const Rgb f_light = light_bsdf.f(v.wo, -dir, TransportMode::Importance) * light_bsdf.abs_cos(dir);
+      const Rgb f_light =
+          light_bsdf.f(v.wo, -dir, TransportMode::Importance) * light_bsdf.abs_cos(dir);
       if (f_light.is_black()) continue;
-      const float w = bidir::weight_connection(it.rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf, mis);
+      const float w =
+          bidir::weight_connection(it.rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf, mis);
       const Rgb value = beta * v.throughput * f_camera * f_light * (w / dist2);
       if (value.is_black()) continue;
       if (scene.occluded(spawn_ray_between(si, light_si))) continue;
@@ -548,8 +578,8 @@ class BidirIntegrator final : public Integrator {
     }
   }
 
-  void merge(const Iteration& it, const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta, const MisSums& mis,
-             int depth, PixelAccumulator& acc) const {
+  void merge(const Iteration& it, const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
+             const MisSums& mis, int depth, PixelAccumulator& acc) const {
     const int max_depth = settings_.max_depth;
     grid_.for_each_near(si.p, vertices_, codec_, [&](uint32_t index, Vec3) {
       const LightVertex& stored = vertices_[index];
@@ -558,8 +588,10 @@ class BidirIntegrator final : public Integrator {
       const LightVertexData v = bidir::unpack_light_vertex(stored, codec_);
       const Rgb f = bsdf.f(si.wo, v.wo, TransportMode::Radiance);
       if (f.is_black()) return;
-      const float w = tech_.unweighted ? 1.f : bidir::weight_merge(it.rules, v.wo, v.mis, si, bsdf, mis);
-      acc.add(true, light_depth + 1, depth + 1, beta * f * v.throughput * (w * it.merge_normalization));
+      const float w =
+          tech_.unweighted ? 1.f : bidir::weight_merge(it.rules, v.wo, v.mis, si, bsdf, mis);
+      acc.add(true, light_depth + 1, depth + 1,
+              beta * f * v.throughput * (w * it.merge_normalization));
     });
   }
 
@@ -588,11 +620,13 @@ class BidirIntegrator final : public Integrator {
 
 }  // namespace
 
-std::unique_ptr<Integrator> make_bidir_integrator(BidirAlgorithm algorithm, const IntegratorSettings& settings) {
+std::unique_ptr<Integrator> make_bidir_integrator(BidirAlgorithm algorithm,
+                                                  const IntegratorSettings& settings) {
   return std::make_unique<BidirIntegrator>(algorithm, settings);
 }
 
-std::unique_ptr<Integrator> make_bidir_integrator(const std::string& name, const IntegratorSettings& settings) {
+std::unique_ptr<Integrator> make_bidir_integrator(const std::string& name,
+                                                  const IntegratorSettings& settings) {
   if (name == "lt") return make_bidir_integrator(BidirAlgorithm::LightTracing, settings);
   if (name == "bpt") return make_bidir_integrator(BidirAlgorithm::Bpt, settings);
   if (name == "ppm") return make_bidir_integrator(BidirAlgorithm::Ppm, settings);

@@ -4,7 +4,8 @@
 
 namespace caustica::bidir {
 
-void HashGrid::build(const std::vector<LightVertex>& vertices, const PositionCodec& codec, float radius) {
+void HashGrid::build(const std::vector<LightVertex>& vertices, const PositionCodec& codec,
+                     float radius) {
   radius2_ = radius * radius;
   const float cell = 2 * radius;
   inv_cell_ = 1.f / cell;

@@ -19,14 +19,17 @@ class HashGrid {
 
   // fn(vertex_index, light_position) for every vertex within the radius of p.
   template <typename Fn>
-  void for_each_near(Vec3 p, const std::vector<LightVertex>& vertices, const PositionCodec& codec, Fn&& fn) const {
+  void for_each_near(Vec3 p, const std::vector<LightVertex>& vertices, const PositionCodec& codec,
+                     Fn&& fn) const {
     if (cell_start_.empty()) return;
     const Vec3 g = (p - lo_) * inv_cell_;
     const int cx = int(std::floor(g.x)), cy = int(std::floor(g.y)), cz = int(std::floor(g.z));
     // The neighbour on the side of the cell that p is closer to, per axis.
-    const int nx = g.x - cx < 0.5f ? -1 : 1, ny = g.y - cy < 0.5f ? -1 : 1, nz = g.z - cz < 0.5f ? -1 : 1;
+    const int nx = g.x - cx < 0.5f ? -1 : 1, ny = g.y - cy < 0.5f ? -1 : 1,
+              nz = g.z - cz < 0.5f ? -1 : 1;
     for (int k = 0; k < 8; ++k) {
-      const uint32_t cell = hash(cx + ((k & 1) ? nx : 0), cy + ((k & 2) ? ny : 0), cz + ((k & 4) ? nz : 0));
+      const uint32_t cell =
+          hash(cx + ((k & 1) ? nx : 0), cy + ((k & 2) ? ny : 0), cz + ((k & 4) ? nz : 0));
       for (uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
         const uint32_t index = indices_[i];
         const Vec3 q = codec.decode(vertices[index].position);
@@ -35,11 +38,14 @@ class HashGrid {
     }
   }
 
-  size_t memory_bytes() const { return (cell_start_.capacity() + indices_.capacity()) * sizeof(uint32_t); }
+  size_t memory_bytes() const {
+    return (cell_start_.capacity() + indices_.capacity()) * sizeof(uint32_t);
+  }
 
  private:
   uint32_t hash(int x, int y, int z) const {
-    return ((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ (uint32_t(z) * 83492791u)) & (table_size_ - 1);
+    return ((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ (uint32_t(z) * 83492791u)) &
+           (table_size_ - 1);
   }
 
   Vec3 lo_;

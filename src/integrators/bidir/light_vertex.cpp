@@ -20,22 +20,28 @@ void encode_throughput(Rgb c, uint32_t* exponent, uint64_t* mantissas) {
   }
   int e;
   std::frexp(m, &e);  // m = f * 2^e, f in [0.5, 1)
-  auto quantise = [&](float v, int exp) { return uint64_t(std::lround(std::max(v, 0.f) * std::ldexp(1.f, kMantissaBits - exp))); };
+  auto quantise = [&](float v, int exp) {
+    return uint64_t(std::lround(std::max(v, 0.f) * std::ldexp(1.f, kMantissaBits - exp)));
+  };
   if (quantise(m, e) > kMantissaMask) ++e;  // rounding carried into the next binade
   e = std::clamp(e, -126, 127);
   *exponent = uint32_t(e + 128);
-  *mantissas = std::min(quantise(c.r, e), kMantissaMask) | std::min(quantise(c.g, e), kMantissaMask) << kMantissaBits |
+  *mantissas = std::min(quantise(c.r, e), kMantissaMask) |
+               std::min(quantise(c.g, e), kMantissaMask) << kMantissaBits |
                std::min(quantise(c.b, e), kMantissaMask) << (2 * kMantissaBits);
 }
 
 Rgb decode_throughput(uint32_t exponent, uint64_t mantissas) {
   if (exponent == 0) return Rgb(0.f);
   const float scale = std::ldexp(1.f, int(exponent) - 128 - kMantissaBits);
-  return {float(mantissas & kMantissaMask) * scale, float((mantissas >> kMantissaBits) & kMantissaMask) * scale,
+  return {float(mantissas & kMantissaMask) * scale,
+          float((mantissas >> kMantissaBits) & kMantissaMask) * scale,
           float((mantissas >> (2 * kMantissaBits)) & kMantissaMask) * scale};
 }
 
-uint32_t snorm16(float v) { return uint32_t(std::lround((std::clamp(v, -1.f, 1.f) * 0.5f + 0.5f) * 65535.f)); }
+uint32_t snorm16(float v) {
+  return uint32_t(std::lround((std::clamp(v, -1.f, 1.f) * 0.5f + 0.5f) * 65535.f));
+}
 float from_snorm16(uint32_t b) { return float(b) / 65535.f * 2.f - 1.f; }
 }  // namespace
 
@@ -84,7 +90,7 @@ Vec3 decode_octahedral(uint32_t bits) {
 }
 
 uint32_t encode_mis_value(float v) {
-  if (!(v > 0)) return 0;                             // also NaN
+  if (!(v > 0)) return 0;                            // also NaN
   const uint32_t bits = std::bit_cast<uint32_t>(v);  // sign bit is 0
   return std::min((bits + 0x40u) >> 7, 0x7f7fffffu >> 7);
 }

@@ -10,7 +10,8 @@ namespace {
 float full_weight(float others) { return others == others ? 1.f / (1.f + others) : 0.f; }
 }  // namespace
 
-MisRules::MisRules(MisHeuristic heuristic, bool connect, bool merge, float light_paths, float radius)
+MisRules::MisRules(MisHeuristic heuristic, bool connect, bool merge, float light_paths,
+                   float radius)
     : power_(heuristic == MisHeuristic::Power), light_paths_(light_paths) {
   const float eta_vcm = kPi * radius * radius * light_paths;  // tech. rep. eq. 20
   vm_factor_ = merge ? mis(eta_vcm) : 0.f;
@@ -22,8 +23,9 @@ MisSums MisRules::camera_start(float camera_pdf_w) const {
   return {mis(light_paths_ / camera_pdf_w), 0.f, 0.f};
 }
 
-MisSums MisRules::light_first_hit(float direct_pdf, float emission_pdf, float cos_at_light, bool delta_light,
-                                  bool finite_light, float dist2, float cos_at_hit) const {
+MisSums MisRules::light_first_hit(float direct_pdf, float emission_pdf, float cos_at_light,
+                                  bool delta_light, bool finite_light, float dist2,
+                                  float cos_at_hit) const {
   MisSums s;
   // eq. 31: the ratio of the direct-sampling pdf of y0 to the emission pdf of (y0, y1).
   s.vcm = mis(direct_pdf / emission_pdf);
@@ -46,7 +48,8 @@ void MisRules::hit(MisSums& s, float dist2, float cos_at_hit) const {
   s.vm *= inv_cos;
 }
 
-void MisRules::scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev, bool specular) const {
+void MisRules::scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev,
+                       bool specular) const {
   if (specular) {
     // eqs. 53-55: no technique can end at a specular vertex (dVCM = 0); pdf_rev == pdf_fwd
     // cancels and only the cosine of the reverse area conversion remains.
@@ -71,8 +74,9 @@ float MisRules::hit_light(const MisSums& camera, float direct_pdf, float emissio
   return full_weight(w_camera);
 }
 
-float MisRules::next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf_pdf_rev, float direct_pdf_w,
-                           float emission_pdf_w, float cos_to_light, float cos_at_light) const {
+float MisRules::next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf_pdf_rev,
+                           float direct_pdf_w, float emission_pdf_w, float cos_to_light,
+                           float cos_at_light) const {
   // eq. 44: BSDF sampling hitting the light instead (both solid angle at the camera vertex).
   const float w_light = mis(bsdf_pdf_fwd / direct_pdf_w);
   // eq. 45: emission_pdf_a / direct_pdf_a at the camera vertex; the dist^2 of both cancel.
@@ -81,16 +85,19 @@ float MisRules::next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf
   return full_weight(w_light + w_camera);
 }
 
-float MisRules::connect(const MisSums& light, const MisSums& camera, float camera_pdf_a, float camera_rev_w,
-                        float light_pdf_a, float light_rev_w) const {
-  const float w_light = mis(camera_pdf_a) * (vm_factor_ + light.vcm + light.vc * mis(light_rev_w));     // eq. 40
-  const float w_camera = mis(light_pdf_a) * (vm_factor_ + camera.vcm + camera.vc * mis(camera_rev_w));  // eq. 41
+float MisRules::connect(const MisSums& light, const MisSums& camera, float camera_pdf_a,
+                        float camera_rev_w, float light_pdf_a, float light_rev_w) const {
+  const float w_light =
+      mis(camera_pdf_a) * (vm_factor_ + light.vcm + light.vc * mis(light_rev_w));  // eq. 40
+  const float w_camera =
+      mis(light_pdf_a) * (vm_factor_ + camera.vcm + camera.vc * mis(camera_rev_w));  // eq. 41
   return full_weight(w_light + w_camera);
 }
 
 float MisRules::light_to_camera(const MisSums& light, float camera_pdf_a, float light_rev_w) const {
   // eq. 46, with the camera density divided by the N light paths that share each pixel.
-  const float w_light = mis(camera_pdf_a / light_paths_) * (vm_factor_ + light.vcm + light.vc * mis(light_rev_w));
+  const float w_light =
+      mis(camera_pdf_a / light_paths_) * (vm_factor_ + light.vcm + light.vc * mis(light_rev_w));
   return full_weight(w_light);
 }
 

@@ -39,8 +39,8 @@ class MisRules {
   // direct-sampling pdf of a sphere light depends on y1). direct_pdf: pmf * NEE density of the
   // light point as sampled from y1, in area measure for finite lights (1 for delta positions),
   // solid angle for infinite ones; emission_pdf: pmf * pdf_pos * pdf_dir. eqs. 31-33, 48-50.
-  MisSums light_first_hit(float direct_pdf, float emission_pdf, float cos_at_light, bool delta_light,
-                          bool finite_light, float dist2, float cos_at_hit) const;
+  MisSums light_first_hit(float direct_pdf, float emission_pdf, float cos_at_light,
+                          bool delta_light, bool finite_light, float dist2, float cos_at_hit) const;
   // Arrival at the next vertex after a scattering: the remaining part of eqs. 34-36.
   void hit(MisSums& s, float dist2, float cos_at_hit) const;
   // Scattering from a vertex: cos_out = |ng . wi| there, pdf_fwd / pdf_rev of the bounce.
@@ -53,11 +53,13 @@ class MisRules {
   // Next event estimation (s = 1). bsdf_pdf_fwd is 0 for delta lights; direct_pdf_w includes the
   // pmf and is pmf * dist^2 for delta positions (area density 1); cos_to_light = |ng . wi| at the
   // camera vertex; cos_at_light = 1 for point-like and infinite lights. eqs. 44-45.
-  float next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf_pdf_rev, float direct_pdf_w,
-                   float emission_pdf_w, float cos_to_light, float cos_at_light) const;
+  float next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf_pdf_rev,
+                   float direct_pdf_w, float emission_pdf_w, float cos_to_light,
+                   float cos_at_light) const;
   // Connection of a light vertex and a camera vertex (s, t >= 2). camera_pdf_a: the camera
   // vertex's BSDF sampling the light vertex (area at the light vertex); light_pdf_a the converse;
-  // the _rev_w pdfs: each vertex's BSDF sampling its own predecessor given the connection. eqs. 40-41.
+  // the _rev_w pdfs: each vertex's BSDF sampling its own predecessor given the connection. eqs.
+  // 40-41.
   float connect(const MisSums& light, const MisSums& camera, float camera_pdf_a, float camera_rev_w,
                 float light_pdf_a, float light_rev_w) const;
   // Light vertex connected to the camera (t = 1): camera_pdf_a = per-pixel camera density of the
@@ -65,7 +67,8 @@ class MisRules {
   float light_to_camera(const MisSums& light, float camera_pdf_a, float light_rev_w) const;
   // Merge of a light vertex with a camera vertex: the camera BSDF's pdfs of the light's incoming
   // direction (fwd) and of its own outgoing direction given that one (rev). eqs. 38-39.
-  float merge(const MisSums& light, const MisSums& camera, float camera_pdf_fwd_w, float camera_pdf_rev_w) const;
+  float merge(const MisSums& light, const MisSums& camera, float camera_pdf_fwd_w,
+              float camera_pdf_rev_w) const;
 
  private:
   bool power_;

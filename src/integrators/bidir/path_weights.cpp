@@ -9,8 +9,9 @@
 
 namespace caustica::bidir {
 
-std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm, MisHeuristic heuristic,
-                                                float light_paths, float radius, const ExplicitPath& path,
+std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
+                                                MisHeuristic heuristic, float light_paths,
+                                                float radius, const ExplicitPath& path,
                                                 ScratchArena& arena) {
   const bool connect = algorithm != BidirAlgorithm::Bpm;
   const bool merge = algorithm != BidirAlgorithm::Bpt;
@@ -53,27 +54,35 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
     } else {
       MisSums m = light_mis[i - 1];
       const bool specular = delta(i - 1);
-      const float pdf_fwd = specular ? 1.f : bsdf[i - 1].pdf(light_si[i - 1].wo, dir(i - 1, i), TransportMode::Importance);
-      scatter_update(rules, m, light_si[i - 1], bsdf[i - 1], light_si[i - 1].wo, dir(i - 1, i), TransportMode::Importance,
-                     specular, pdf_fwd);
+      const float pdf_fwd =
+          specular ? 1.f
+                   : bsdf[i - 1].pdf(light_si[i - 1].wo, dir(i - 1, i), TransportMode::Importance);
+      scatter_update(rules, m, light_si[i - 1], bsdf[i - 1], light_si[i - 1].wo, dir(i - 1, i),
+                     TransportMode::Importance, specular, pdf_fwd);
       rules.hit(m, distance_squared(x[i - 1], x[i]), geometric_cos(light_si[i], dir(i, i - 1)));
       light_mis[i] = m;
     }
   }
   auto stored = [&](int i) {
-    return unpack_light_vertex(pack_light_vertex({x[i], light_si[i].wo, 0, i, Rgb(1.f), light_mis[i]}, codec), codec).mis;
+    return unpack_light_vertex(
+               pack_light_vertex({x[i], light_si[i].wo, 0, i, Rgb(1.f), light_mis[i]}, codec),
+               codec)
+        .mis;
   };
 
   // Camera subpath replay: sums at x(k-1) down to x1, and at the emitter (s = 0).
   std::vector<MisSums> camera_mis(k);
   camera_mis[k - 1] = rules.camera_start(camera_pdf_w(scene.camera(), dir(k, k - 1)));
-  rules.hit(camera_mis[k - 1], distance_squared(x[k], x[k - 1]), geometric_cos(camera_si[k - 1], dir(k - 1, k)));
+  rules.hit(camera_mis[k - 1], distance_squared(x[k], x[k - 1]),
+            geometric_cos(camera_si[k - 1], dir(k - 1, k)));
   for (int i = k - 2; i >= 1; --i) {
     MisSums m = camera_mis[i + 1];
     const bool specular = delta(i + 1);
-    const float pdf_fwd = specular ? 1.f : bsdf[i + 1].pdf(camera_si[i + 1].wo, dir(i + 1, i), TransportMode::Radiance);
-    scatter_update(rules, m, camera_si[i + 1], bsdf[i + 1], camera_si[i + 1].wo, dir(i + 1, i), TransportMode::Radiance,
-                   specular, pdf_fwd);
+    const float pdf_fwd =
+        specular ? 1.f
+                 : bsdf[i + 1].pdf(camera_si[i + 1].wo, dir(i + 1, i), TransportMode::Radiance);
+    scatter_update(rules, m, camera_si[i + 1], bsdf[i + 1], camera_si[i + 1].wo, dir(i + 1, i),
+                   TransportMode::Radiance, specular, pdf_fwd);
     rules.hit(m, distance_squared(x[i + 1], x[i]), geometric_cos(camera_si[i], dir(i, i + 1)));
     camera_mis[i] = m;
   }
@@ -84,8 +93,10 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   if (connect && !light.is_delta()) {
     MisSums m = camera_mis[1];
     const bool specular = delta(1);
-    const float pdf_fwd = specular ? 1.f : bsdf[1].pdf(camera_si[1].wo, to_light, TransportMode::Radiance);
-    scatter_update(rules, m, camera_si[1], bsdf[1], camera_si[1].wo, to_light, TransportMode::Radiance, specular, pdf_fwd);
+    const float pdf_fwd =
+        specular ? 1.f : bsdf[1].pdf(camera_si[1].wo, to_light, TransportMode::Radiance);
+    scatter_update(rules, m, camera_si[1], bsdf[1], camera_si[1].wo, to_light,
+                   TransportMode::Radiance, specular, pdf_fwd);
     float w;
     if (finite) {
       SurfaceInteraction emitter;
@@ -109,26 +120,28 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
     ls.pdf_w = light.is_delta() ? 1.f : light.pdf_li(x[1], ls.wi, x[0], ls.n_light);
     light.pdf_le(x[0], le.n, -ls.wi, &ls.pdf_emit_pos, &ls.pdf_emit_dir);
     ls.cos_at_light = light.type() == LightType::Area ? abs_dot(path.light_normal, ls.wi) : 1.f;
-    out.push_back({false, 1, k, weight_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1])});
+    out.push_back({false, 1, k,
+                   weight_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1])});
   }
   // 2 <= s <= k - 1: connections of x(s-1) and x(s).
   for (int s = 2; connect && s <= k - 1; ++s) {
     if (delta(s - 1) || delta(s)) continue;
     out.push_back({false, s, k + 1 - s,
-                   weight_connection(rules, light_si[s - 1], bsdf[s - 1], light_si[s - 1].wo, stored(s - 1), camera_si[s],
-                                     bsdf[s], camera_mis[s])});
+                   weight_connection(rules, light_si[s - 1], bsdf[s - 1], light_si[s - 1].wo,
+                                     stored(s - 1), camera_si[s], bsdf[s], camera_mis[s])});
   }
   // t = 1: x(k-1) connected to the lens.
   if (connect && k >= 2 && !delta(k - 1)) {
     out.push_back({false, k, 1,
-                   weight_light_to_camera(rules, scene.camera(), light_si[k - 1], bsdf[k - 1], light_si[k - 1].wo,
-                                          stored(k - 1), x[k])});
+                   weight_light_to_camera(rules, scene.camera(), light_si[k - 1], bsdf[k - 1],
+                                          light_si[k - 1].wo, stored(k - 1), x[k])});
   }
   // Merges at every non-delta interior vertex.
   for (int j = 1; merge && j <= k - 1; ++j) {
     if (delta(j)) continue;
-    out.push_back({true, j + 1, k + 1 - j,
-                   weight_merge(rules, light_si[j].wo, stored(j), camera_si[j], bsdf[j], camera_mis[j])});
+    out.push_back(
+        {true, j + 1, k + 1 - j,
+         weight_merge(rules, light_si[j].wo, stored(j), camera_si[j], bsdf[j], camera_mis[j])});
   }
   return out;
 }

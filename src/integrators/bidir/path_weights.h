@@ -35,8 +35,9 @@ struct TechniqueWeight {
 
 // Weights of every technique of `algorithm` (Bpt, Bpm or Vcm) able to produce the path
 // (delta vertices are recognised by Bsdf::is_delta; mixed BSDFs are treated as non-delta).
-std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm, MisHeuristic heuristic,
-                                                float light_paths, float radius, const ExplicitPath& path,
+std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
+                                                MisHeuristic heuristic, float light_paths,
+                                                float radius, const ExplicitPath& path,
                                                 ScratchArena& arena);
 
 }  // namespace caustica::bidir

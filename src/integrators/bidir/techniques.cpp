@@ -8,12 +8,13 @@ namespace caustica::bidir {
 float camera_pdf_w(const Camera& camera, Vec3 dir) {
   float pdf_pos, pdf_dir;
   camera.pdf_we(dir, &pdf_pos, &pdf_dir);
-  // pdf_we is normalised over the whole image; one camera sample per pixel sees pixel_count times it.
+  // pdf_we is normalised over the whole image; one camera sample per pixel sees pixel_count times
+  // it.
   return float(camera.pixel_count()) * pdf_dir;
 }
 
-MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf, const LightLeSample& le,
-                            const SurfaceInteraction& y1, float dist) {
+MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf,
+                            const LightLeSample& le, const SurfaceInteraction& y1, float dist) {
   const bool finite = !light.is_infinite();
   const float dist2 = dist * dist;
   float direct;
@@ -29,14 +30,15 @@ MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf
                                geometric_cos(y1, le.dir));
 }
 
-void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
-                    Vec3 wi, TransportMode mode, bool specular, float pdf_fwd) {
+void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteraction& si,
+                    const Bsdf& bsdf, Vec3 wo, Vec3 wi, TransportMode mode, bool specular,
+                    float pdf_fwd) {
   const float pdf_rev = specular ? pdf_fwd : bsdf.pdf(wi, wo, !mode);
   rules.scatter(mis, geometric_cos(si, wi), pdf_fwd, pdf_rev, specular);
 }
 
-float weight_emitter_hit(const MisRules& rules, const Light& light, float pmf, Vec3 prev_p, Vec3 dir,
-                         const SurfaceInteraction* hit, const MisSums& camera) {
+float weight_emitter_hit(const MisRules& rules, const Light& light, float pmf, Vec3 prev_p,
+                         Vec3 dir, const SurfaceInteraction* hit, const MisSums& camera) {
   float pdf_pos = 0, pdf_dir = 0, direct;
   if (hit) {
     light.pdf_le(hit->p, hit->ng, hit->wo, &pdf_pos, &pdf_dir);
@@ -49,32 +51,38 @@ float weight_emitter_hit(const MisRules& rules, const Light& light, float pmf, V
   return rules.hit_light(camera, direct, pmf * pdf_pos * pdf_dir);
 }
 
-float weight_next_event(const MisRules& rules, const Light& light, float pmf, const LightLiSample& ls,
-                        const SurfaceInteraction& si, const Bsdf& bsdf, const MisSums& camera) {
+float weight_next_event(const MisRules& rules, const Light& light, float pmf,
+                        const LightLiSample& ls, const SurfaceInteraction& si, const Bsdf& bsdf,
+                        const MisSums& camera) {
   const float bsdf_fwd = light.is_delta() ? 0.f : bsdf.pdf(si.wo, ls.wi, TransportMode::Radiance);
   const float bsdf_rev = bsdf.pdf(ls.wi, si.wo, TransportMode::Importance);
   // Delta positions have area density 1: in solid angle at si that is dist^2.
-  const float direct_w = pmf * (light.type() == LightType::DeltaPosition ? ls.distance * ls.distance : ls.pdf_w);
+  const float direct_w =
+      pmf * (light.type() == LightType::DeltaPosition ? ls.distance * ls.distance : ls.pdf_w);
   const float emission_w = pmf * ls.pdf_emit_pos * ls.pdf_emit_dir;
-  return rules.next_event(camera, bsdf_fwd, bsdf_rev, direct_w, emission_w, geometric_cos(si, ls.wi), ls.cos_at_light);
+  return rules.next_event(camera, bsdf_fwd, bsdf_rev, direct_w, emission_w,
+                          geometric_cos(si, ls.wi), ls.cos_at_light);
 }
 
-float weight_connection(const MisRules& rules, const SurfaceInteraction& light_si, const Bsdf& light_bsdf,
-                        Vec3 light_wo, const MisSums& light, const SurfaceInteraction& camera_si,
-                        const Bsdf& camera_bsdf, const MisSums& camera) {
+float weight_connection(const MisRules& rules, const SurfaceInteraction& light_si,
+                        const Bsdf& light_bsdf, Vec3 light_wo, const MisSums& light,
+                        const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
+                        const MisSums& camera) {
   const Vec3 d = light_si.p - camera_si.p;
   const float dist2 = length_squared(d);
   const Vec3 dir = d / std::sqrt(dist2);  // camera vertex -> light vertex
-  const float camera_pdf_a =
-      camera_bsdf.pdf(camera_si.wo, dir, TransportMode::Radiance) * geometric_cos(light_si, dir) / dist2;
+  const float camera_pdf_a = camera_bsdf.pdf(camera_si.wo, dir, TransportMode::Radiance) *
+                             geometric_cos(light_si, dir) / dist2;
   const float camera_rev = camera_bsdf.pdf(dir, camera_si.wo, TransportMode::Importance);
-  const float light_pdf_a = light_bsdf.pdf(light_wo, -dir, TransportMode::Importance) * geometric_cos(camera_si, dir) / dist2;
+  const float light_pdf_a = light_bsdf.pdf(light_wo, -dir, TransportMode::Importance) *
+                            geometric_cos(camera_si, dir) / dist2;
   const float light_rev = light_bsdf.pdf(-dir, light_wo, TransportMode::Radiance);
   return rules.connect(light, camera, camera_pdf_a, camera_rev, light_pdf_a, light_rev);
 }
 
-float weight_light_to_camera(const MisRules& rules, const Camera& camera, const SurfaceInteraction& si,
-                             const Bsdf& bsdf, Vec3 wo, const MisSums& light, Vec3 p_lens) {
+float weight_light_to_camera(const MisRules& rules, const Camera& camera,
+                             const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
+                             const MisSums& light, Vec3 p_lens) {
   const Vec3 d = p_lens - si.p;
   const float dist2 = length_squared(d);
   const Vec3 dir = d / std::sqrt(dist2);
@@ -83,8 +91,9 @@ float weight_light_to_camera(const MisRules& rules, const Camera& camera, const 
   return rules.light_to_camera(light, camera_pdf_a, rev);
 }
 
-float weight_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light, const SurfaceInteraction& camera_si,
-                   const Bsdf& camera_bsdf, const MisSums& camera) {
+float weight_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,
+                   const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
+                   const MisSums& camera) {
   const float fwd = camera_bsdf.pdf(camera_si.wo, light_wo, TransportMode::Radiance);
   const float rev = camera_bsdf.pdf(light_wo, camera_si.wo, TransportMode::Importance);
   return rules.merge(light, camera, fwd, rev);

@@ -25,29 +25,34 @@ inline float geometric_cos(const SurfaceInteraction& si, Vec3 w) { return abs_do
 float camera_pdf_w(const Camera& camera, Vec3 dir);
 
 // MIS sums at the first light vertex y1, reached at distance dist from the emission sample.
-MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf, const LightLeSample& le,
-                            const SurfaceInteraction& y1, float dist);
+MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf,
+                            const LightLeSample& le, const SurfaceInteraction& y1, float dist);
 // Scattering at si from wo into wi; pdf_fwd is the sample's pdf (ignored for specular bounces).
-void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
-                    Vec3 wi, TransportMode mode, bool specular, float pdf_fwd);
+void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteraction& si,
+                    const Bsdf& bsdf, Vec3 wo, Vec3 wi, TransportMode mode, bool specular,
+                    float pdf_fwd);
 
 // Camera subpath reaches an emitter: an area light at `hit` (seen from prev_p) or, with hit ==
 // nullptr, an infinite light along dir (leaving prev_p). `camera` is the camera sums at the
 // emitter (after hit() for area lights, before it for infinite ones).
-float weight_emitter_hit(const MisRules& rules, const Light& light, float pmf, Vec3 prev_p, Vec3 dir,
-                         const SurfaceInteraction* hit, const MisSums& camera);
+float weight_emitter_hit(const MisRules& rules, const Light& light, float pmf, Vec3 prev_p,
+                         Vec3 dir, const SurfaceInteraction* hit, const MisSums& camera);
 // Next event estimation from camera vertex (si, bsdf) with wo.
-float weight_next_event(const MisRules& rules, const Light& light, float pmf, const LightLiSample& ls,
-                        const SurfaceInteraction& si, const Bsdf& bsdf, const MisSums& camera);
+float weight_next_event(const MisRules& rules, const Light& light, float pmf,
+                        const LightLiSample& ls, const SurfaceInteraction& si, const Bsdf& bsdf,
+                        const MisSums& camera);
 // Connection of light vertex (light_si with its wo, BSDF, sums) and camera vertex.
-float weight_connection(const MisRules& rules, const SurfaceInteraction& light_si, const Bsdf& light_bsdf,
-                        Vec3 light_wo, const MisSums& light, const SurfaceInteraction& camera_si,
-                        const Bsdf& camera_bsdf, const MisSums& camera);
+float weight_connection(const MisRules& rules, const SurfaceInteraction& light_si,
+                        const Bsdf& light_bsdf, Vec3 light_wo, const MisSums& light,
+                        const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
+                        const MisSums& camera);
 // Light vertex connected to the lens point p_lens.
-float weight_light_to_camera(const MisRules& rules, const Camera& camera, const SurfaceInteraction& si,
-                             const Bsdf& bsdf, Vec3 wo, const MisSums& light, Vec3 p_lens);
+float weight_light_to_camera(const MisRules& rules, const Camera& camera,
+                             const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
+                             const MisSums& light, Vec3 p_lens);
 // Merge of a light vertex that arrived along light_wo with a camera vertex.
-float weight_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light, const SurfaceInteraction& camera_si,
-                   const Bsdf& camera_bsdf, const MisSums& camera);
+float weight_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,
+                   const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
+                   const MisSums& camera);
 
 }  // namespace caustica::bidir

@@ -5,7 +5,9 @@
 namespace caustica::pbrt {
 
 std::string LoaderContext::resolve(const std::string& name, const SourceLocation& where) const {
-  if (!allow_files) throw SceneLoadError(where, "cannot read \"" + name + "\": file access is disabled when parsing from memory");
+  if (!allow_files)
+    throw SceneLoadError(
+        where, "cannot read \"" + name + "\": file access is disabled when parsing from memory");
   namespace fs = std::filesystem;
   const fs::path path(name);
   if (path.is_absolute()) return name;

@@ -20,13 +20,15 @@ bool finite_vec(Vec3 v) { return is_finite(v); }
 
 }  // namespace
 
-AreaLightDesc make_area_light(const std::string& type, const ParamList& params, const SourceLocation& where,
-                              LoaderContext& ctx) {
-  if (type != "diffuse") throw SceneLoadError(where, "unknown area light type \"" + type + "\" (expected \"diffuse\")");
+AreaLightDesc make_area_light(const std::string& type, const ParamList& params,
+                              const SourceLocation& where, LoaderContext& ctx) {
+  if (type != "diffuse")
+    throw SceneLoadError(where, "unknown area light type \"" + type + "\" (expected \"diffuse\")");
   AreaLightDesc a;
   a.where = where;
   if (const Param* fp = params.find("filename")) {
-    ctx.warnings.warn(fp->where, "image-textured area lights are not supported; using \"L\"", "area light filename");
+    ctx.warnings.warn(fp->where, "image-textured area lights are not supported; using \"L\"",
+                      "area light filename");
   }
   a.radiance = emission(params, "L", ctx);
   a.two_sided = params.get_bool("twosided", false);
@@ -36,7 +38,8 @@ AreaLightDesc make_area_light(const std::string& type, const ParamList& params, 
 }
 
 void add_light_source(const std::string& type, const ParamList& params, const SourceLocation& where,
-                      const Transform& light_to_world, MaterialFactory& images, SceneBuilder& builder, LoaderContext& ctx) {
+                      const Transform& light_to_world, MaterialFactory& images,
+                      SceneBuilder& builder, LoaderContext& ctx) {
   const std::string context = "LightSource \"" + type + "\"";
   LightPtr light;
   if (type == "point") {
@@ -48,7 +51,8 @@ void add_light_source(const std::string& type, const ParamList& params, const So
     light = make_point_light(from, I);
   } else if (type == "spot") {
     Rgb I = emission(params, "I", ctx);
-    const float cone = params.get_float("coneangle", 30), delta = params.get_float("conedeltaangle", 5);
+    const float cone = params.get_float("coneangle", 30),
+                delta = params.get_float("conedeltaangle", 5);
     const Vec3 from = params.get_point3("from", {0, 0, 0}), to = params.get_point3("to", {0, 0, 1});
     if (from == to) throw SceneLoadError(where, "spot: \"from\" and \"to\" are the same point");
     const float power = params.get_float("power", -1);
@@ -59,7 +63,8 @@ void add_light_source(const std::string& type, const ParamList& params, const So
       if (k_e > 0) I = I * (power / k_e);
     }
     const Vec3 p = light_to_world.point(from), dir = light_to_world.vector(to - from);
-    if (!finite_vec(p) || !(length(dir) > 0) || !finite_vec(dir)) throw SceneLoadError(where, "spot light transform is degenerate");
+    if (!finite_vec(p) || !(length(dir) > 0) || !finite_vec(dir))
+      throw SceneLoadError(where, "spot light transform is degenerate");
     light = make_spot_light(p, normalize(dir), I, cone, delta);
   } else if (type == "distant") {
     Rgb L = emission(params, "L", ctx);
@@ -68,26 +73,32 @@ void add_light_source(const std::string& type, const ParamList& params, const So
     const float illuminance = params.get_float("illuminance", -1);
     if (illuminance > 0) L = L * illuminance;
     const Vec3 dir = light_to_world.vector(to - from);
-    if (!(length(dir) > 0) || !finite_vec(dir)) throw SceneLoadError(where, "distant light transform is degenerate");
+    if (!(length(dir) > 0) || !finite_vec(dir))
+      throw SceneLoadError(where, "distant light transform is degenerate");
     light = make_distant_light(normalize(dir), L);
   } else if (type == "infinite") {
     const Param* lp = params.find("L");
     const Param* fp = params.find("filename", {ParamType::String});
-    if (lp && fp) throw SceneLoadError(where, "infinite: \"L\" and \"filename\" cannot both be given");
+    if (lp && fp)
+      throw SceneLoadError(where, "infinite: \"L\" and \"filename\" cannot both be given");
     if (params.find("portal"))
-      ctx.warnings.warn(params.find("portal")->where, "infinite light portals are not supported; ignored", "portal");
+      ctx.warnings.warn(params.find("portal")->where,
+                        "infinite light portals are not supported; ignored", "portal");
     if (fp) {
       const float scale = params.get_float("scale", 1);
       if (params.find("illuminance"))
         ctx.warnings.warn(params.find("illuminance")->where,
-                          "\"illuminance\" is not supported for image infinite lights; ignored", "image illuminance");
+                          "\"illuminance\" is not supported for image infinite lights; ignored",
+                          "image illuminance");
       const std::string path = ctx.resolve(params.get_string("filename", ""), fp->where);
       std::shared_ptr<const Image> image = images.load_image(path, false, *fp);
       EnvironmentMapping mapping = EnvironmentMapping::EqualAreaOctahedral;
       if (image->width() != image->height()) {
-        ctx.warnings.warn(fp->where, "environment map \"" + fp->strings[0] + "\" is " + std::to_string(image->width()) + "x" +
+        ctx.warnings.warn(fp->where, "environment map \"" + fp->strings[0] + "\" is " +
+                                         std::to_string(image->width()) + "x" +
                                          std::to_string(image->height()) +
-                                         ", not square: reading it as lat-long (pbrt-v4 expects an equal-area octahedral map)");
+                                         ", not square: reading it as lat-long (pbrt-v4 expects an "
+                                         "equal-area octahedral map)");
         mapping = EnvironmentMapping::LatLong;
       }
       light = make_image_environment(image, mapping, light_to_world, Rgb(scale));
@@ -102,7 +113,9 @@ void add_light_source(const std::string& type, const ParamList& params, const So
     for (const Param& p : params.all()) p.used = true;
     return;
   } else {
-    throw SceneLoadError(where, "unknown light type \"" + type + "\" (expected point, spot, distant, infinite, goniometric or projection)");
+    throw SceneLoadError(
+        where, "unknown light type \"" + type +
+                   "\" (expected point, spot, distant, infinite, goniometric or projection)");
   }
   params.report_unused(ctx.warnings, context);
   builder.add_light(std::move(light));

@@ -18,17 +18,18 @@
 namespace caustica::pbrt {
 
 struct AreaLightDesc {
-  Rgb radiance;        // after scale and normalisation, before power
+  Rgb radiance;  // after scale and normalisation, before power
   bool two_sided = false;
-  float power = -1;    // > 0: pbrt-v4 rescales each shape (each triangle) to emit this power
+  float power = -1;  // > 0: pbrt-v4 rescales each shape (each triangle) to emit this power
   SourceLocation where;
 };
 
-AreaLightDesc make_area_light(const std::string& type, const ParamList& params, const SourceLocation& where,
-                              LoaderContext& ctx);
+AreaLightDesc make_area_light(const std::string& type, const ParamList& params,
+                              const SourceLocation& where, LoaderContext& ctx);
 
 // Adds the light to `builder` (nothing if unsupported, with a warning).
 void add_light_source(const std::string& type, const ParamList& params, const SourceLocation& where,
-                      const Transform& light_to_world, MaterialFactory& images, SceneBuilder& builder, LoaderContext& ctx);
+                      const Transform& light_to_world, MaterialFactory& images,
+                      SceneBuilder& builder, LoaderContext& ctx);
 
 }  // namespace caustica::pbrt

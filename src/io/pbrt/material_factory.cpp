@@ -13,7 +13,8 @@ namespace {
 // pbrt-v4 "mix" texture: lerp(amount, tex1, tex2).
 class MixTexture final : public Texture {
  public:
-  MixTexture(TexturePtr a, TexturePtr b, TexturePtr amount) : a_(std::move(a)), b_(std::move(b)), amount_(std::move(amount)) {}
+  MixTexture(TexturePtr a, TexturePtr b, TexturePtr amount)
+      : a_(std::move(a)), b_(std::move(b)), amount_(std::move(amount)) {}
   Rgb eval(const TextureContext& ctx) const override {
     const float t = amount_->eval_float(ctx);
     return a_->eval(ctx) * (1 - t) + b_->eval(ctx) * t;
@@ -32,13 +33,15 @@ std::string lower_extension(const std::string& path) {
   const size_t dot = path.find_last_of('.');
   if (dot == std::string::npos || path.find_first_of("/\\", dot) != std::string::npos) return {};
   std::string ext = path.substr(dot);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
   return ext;
 }
 
 }  // namespace
 
-std::shared_ptr<const Image> MaterialFactory::load_image(const std::string& path, bool srgb, const Param& where) {
+std::shared_ptr<const Image> MaterialFactory::load_image(const std::string& path, bool srgb,
+                                                         const Param& where) {
   auto key = std::make_pair(path, srgb);
   auto it = images_.find(key);
   if (it != images_.end()) return it->second;
@@ -53,19 +56,23 @@ std::shared_ptr<const Image> MaterialFactory::load_image(const std::string& path
   return image;
 }
 
-TexturePtr MaterialFactory::texture_param(const ParamList& params, const std::string& name, bool is_float, Rgb def) {
-  TexturePtr t = is_float ? float_texture(params, name, def.r) : spectrum_texture(params, name, def, SpectrumKind::Albedo);
+TexturePtr MaterialFactory::texture_param(const ParamList& params, const std::string& name,
+                                          bool is_float, Rgb def) {
+  TexturePtr t = is_float ? float_texture(params, name, def.r)
+                          : spectrum_texture(params, name, def, SpectrumKind::Albedo);
   return t;
 }
 
-TexturePtr MaterialFactory::spectrum_texture(const ParamList& params, const std::string& name, std::optional<Rgb> def,
-                                             SpectrumKind kind) {
-  const Param* p = params.find(name, {ParamType::Rgb, ParamType::Spectrum, ParamType::Blackbody, ParamType::Texture, ParamType::Float});
+TexturePtr MaterialFactory::spectrum_texture(const ParamList& params, const std::string& name,
+                                             std::optional<Rgb> def, SpectrumKind kind) {
+  const Param* p = params.find(name, {ParamType::Rgb, ParamType::Spectrum, ParamType::Blackbody,
+                                      ParamType::Texture, ParamType::Float});
   if (!p) return def ? make_constant_texture(*def) : nullptr;
   if (p->type == ParamType::Texture) {
     if (p->strings.size() != 1) param_error(*p, "expected one texture name");
     auto it = spectrum_textures_.find(p->strings[0]);
-    if (it == spectrum_textures_.end()) param_error(*p, "no spectrum texture named \"" + p->strings[0] + "\"");
+    if (it == spectrum_textures_.end())
+      param_error(*p, "no spectrum texture named \"" + p->strings[0] + "\"");
     return it->second;
   }
   if (p->type == ParamType::Float) {
@@ -76,34 +83,45 @@ TexturePtr MaterialFactory::spectrum_texture(const ParamList& params, const std:
   return make_constant_texture(spectrum_param_rgb(*p, kind, ctx_));
 }
 
-TexturePtr MaterialFactory::float_texture(const ParamList& params, const std::string& name, std::optional<float> def) {
+TexturePtr MaterialFactory::float_texture(const ParamList& params, const std::string& name,
+                                          std::optional<float> def) {
   const Param* p = params.find(name, {ParamType::Float, ParamType::Texture});
   if (!p) return def ? make_constant_texture(Rgb(*def)) : nullptr;
   if (p->type == ParamType::Texture) {
     if (p->strings.size() != 1) param_error(*p, "expected one texture name");
     auto it = float_textures_.find(p->strings[0]);
-    if (it == float_textures_.end()) param_error(*p, "no float texture named \"" + p->strings[0] + "\"");
+    if (it == float_textures_.end())
+      param_error(*p, "no float texture named \"" + p->strings[0] + "\"");
     return it->second;
   }
-  if (p->numbers.size() != 1) param_error(*p, "expected one value, got " + std::to_string(p->numbers.size()));
+  if (p->numbers.size() != 1)
+    param_error(*p, "expected one value, got " + std::to_string(p->numbers.size()));
   return make_constant_texture(Rgb(float(p->numbers[0])));
 }
 
-void MaterialFactory::define_texture(const std::string& name, const std::string& type, const std::string& cls,
-                                     const ParamList& params, const SourceLocation& where, const SourceLocation& name_where) {
+void MaterialFactory::define_texture(const std::string& name, const std::string& type,
+                                     const std::string& cls, const ParamList& params,
+                                     const SourceLocation& where,
+                                     const SourceLocation& name_where) {
   bool is_float;
-  if (type == "float") is_float = true;
-  else if (type == "spectrum" || type == "color" || type == "rgb") is_float = false;
-  else throw SceneLoadError(where, "Texture \"" + name + "\": unknown texture type \"" + type + "\" (expected \"float\" or \"spectrum\")");
+  if (type == "float")
+    is_float = true;
+  else if (type == "spectrum" || type == "color" || type == "rgb")
+    is_float = false;
+  else
+    throw SceneLoadError(where, "Texture \"" + name + "\": unknown texture type \"" + type +
+                                    "\" (expected \"float\" or \"spectrum\")");
   auto& table = is_float ? float_textures_ : spectrum_textures_;
-  if (table.count(name)) throw SceneLoadError(name_where, "texture \"" + name + "\" is defined twice");
+  if (table.count(name))
+    throw SceneLoadError(name_where, "texture \"" + name + "\" is defined twice");
 
   const std::string context = "Texture \"" + cls + "\"";
   UvMapping mapping;
   auto read_mapping = [&]() {
     const std::string m = params.get_string("mapping", "uv");
     if (m != "uv")
-      ctx_.warnings.warn(params.find("mapping")->where, "texture mapping \"" + m + "\" is not supported; using \"uv\"",
+      ctx_.warnings.warn(params.find("mapping")->where,
+                         "texture mapping \"" + m + "\" is not supported; using \"uv\"",
                          "mapping " + m);
     mapping.su = params.get_float("uscale", 1);
     mapping.sv = params.get_float("vscale", 1);
@@ -127,7 +145,9 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
     read_mapping();
     const int dim = params.get_int("dimension", 2);
     if (dim != 2 && dim != 3) param_error(*params.find("dimension"), "expected 2 or 3");
-    if (dim == 3) ctx_.warnings.warn(where, "3D checkerboard textures are not supported; using the 2D one on uv");
+    if (dim == 3)
+      ctx_.warnings.warn(where,
+                         "3D checkerboard textures are not supported; using the 2D one on uv");
     TexturePtr a = texture_param(params, "tex1", is_float, Rgb(1.f));
     TexturePtr b = texture_param(params, "tex2", is_float, Rgb(0.f));
     tex = std::make_shared<CheckerboardTexture>(a, b, mapping);
@@ -141,31 +161,41 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
     const std::string ext = lower_extension(filename);
     std::string encoding = params.get_string("encoding", ext == ".png" ? "sRGB" : "linear");
     bool srgb = false;
-    if (encoding == "sRGB") srgb = true;
-    else if (encoding == "linear") srgb = false;
+    if (encoding == "sRGB")
+      srgb = true;
+    else if (encoding == "linear")
+      srgb = false;
     else if (encoding.rfind("gamma ", 0) == 0) {
-      ctx_.warnings.warn(params.find("encoding")->where, "imagemap encoding \"" + encoding + "\" is approximated by sRGB");
+      ctx_.warnings.warn(params.find("encoding")->where,
+                         "imagemap encoding \"" + encoding + "\" is approximated by sRGB");
       srgb = true;
     } else {
-      param_error(*params.find("encoding"), "expected \"sRGB\", \"linear\" or \"gamma <value>\", got \"" + encoding + "\"");
+      param_error(*params.find("encoding"),
+                  "expected \"sRGB\", \"linear\" or \"gamma <value>\", got \"" + encoding + "\"");
     }
     const std::string filter = params.get_string("filter", "bilinear");
-    if (filter != "bilinear" && filter != "point" && filter != "trilinear" && filter != "ewa" && filter != "EWA")
-      param_error(*params.find("filter"), "expected point, bilinear, trilinear or ewa, got \"" + filter + "\"");
+    if (filter != "bilinear" && filter != "point" && filter != "trilinear" && filter != "ewa" &&
+        filter != "EWA")
+      param_error(*params.find("filter"),
+                  "expected point, bilinear, trilinear or ewa, got \"" + filter + "\"");
     if (filter != "bilinear")
-      ctx_.warnings.warn(params.find("filter")->where, "imagemap filter \"" + filter + "\" is not supported; using bilinear",
+      ctx_.warnings.warn(params.find("filter")->where,
+                         "imagemap filter \"" + filter + "\" is not supported; using bilinear",
                          "filter " + filter);
     const std::string wrap = params.get_string("wrap", "repeat");
     if (wrap != "repeat")
-      ctx_.warnings.warn(params.find("wrap")->where, "imagemap wrap \"" + wrap + "\" is not supported; using repeat",
+      ctx_.warnings.warn(params.find("wrap")->where,
+                         "imagemap wrap \"" + wrap + "\" is not supported; using repeat",
                          "wrap " + wrap);
     params.find("maxanisotropy");
     const float scale = params.get_float("scale", 1);
     const bool invert = params.get_bool("invert", false);
     tex = std::make_shared<ImageTexture>(load_image(path, srgb, *fp), mapping, Rgb(scale), invert);
-  } else if (cls == "bilerp" || cls == "directionmix" || cls == "dots" || cls == "fbm" || cls == "wrinkled" ||
-             cls == "windy" || cls == "marble" || cls == "ptex") {
-    ctx_.warnings.warn(where, "texture class \"" + cls + "\" is not supported; using a constant 0.5", "texture " + cls);
+  } else if (cls == "bilerp" || cls == "directionmix" || cls == "dots" || cls == "fbm" ||
+             cls == "wrinkled" || cls == "windy" || cls == "marble" || cls == "ptex") {
+    ctx_.warnings.warn(where,
+                       "texture class \"" + cls + "\" is not supported; using a constant 0.5",
+                       "texture " + cls);
     for (const Param& p : params.all()) p.used = true;
     tex = make_constant_texture(Rgb(0.5f));
   } else {
@@ -175,12 +205,14 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
   table[name] = std::move(tex);
 }
 
-MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamList& params, const SourceLocation& where,
+MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamList& params,
+                                           const SourceLocation& where,
                                            const NamedMaterialLookup& named) {
   const std::string context = "Material \"" + type + "\"";
   if (params.find("displacement"))
     ctx_.warnings.warn(where, "material displacement is not supported; ignored", "displacement");
-  if (params.find("normalmap")) ctx_.warnings.warn(where, "normal maps are not supported; ignored", "normalmap");
+  if (params.find("normalmap"))
+    ctx_.warnings.warn(where, "normal maps are not supported; ignored", "normalmap");
 
   auto roughness = [&](TexturePtr* u, TexturePtr* v, bool* remap) {
     *u = float_texture(params, "uroughness", std::nullopt);
@@ -193,7 +225,8 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
     *remap = params.get_bool("remaproughness", true);
   };
   auto eta_value = [&](float def) {
-    const Param* p = params.find("eta", {ParamType::Float, ParamType::Spectrum, ParamType::Rgb, ParamType::Texture});
+    const Param* p = params.find(
+        "eta", {ParamType::Float, ParamType::Spectrum, ParamType::Rgb, ParamType::Texture});
     if (!p) return def;
     if (p->type == ParamType::Float) {
       if (p->numbers.size() != 1) param_error(*p, "expected one value");
@@ -219,22 +252,29 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
   } else if (type == "conductor" || type == "coatedconductor") {
     const std::string prefix = type == "coatedconductor" ? "conductor." : "";
     if (type == "coatedconductor") {
-      ctx_.warnings.warn(where, "material \"coatedconductor\" is not supported; using its conductor without the coat",
-                         "coatedconductor");
+      ctx_.warnings.warn(
+          where,
+          "material \"coatedconductor\" is not supported; using its conductor without the coat",
+          "coatedconductor");
       for (const Param& p : params.all())
-        if (p.name.rfind("interface.", 0) == 0 || p.name == "thickness" || p.name == "albedo" || p.name == "g" ||
-            p.name == "maxdepth" || p.name == "nsamples")
+        if (p.name.rfind("interface.", 0) == 0 || p.name == "thickness" || p.name == "albedo" ||
+            p.name == "g" || p.name == "maxdepth" || p.name == "nsamples")
           p.used = true;
     }
     ConductorParams c;
-    c.reflectance = spectrum_texture(params, prefix + "reflectance", std::nullopt, SpectrumKind::Albedo);
+    c.reflectance =
+        spectrum_texture(params, prefix + "reflectance", std::nullopt, SpectrumKind::Albedo);
     c.eta = spectrum_texture(params, prefix + "eta", std::nullopt, SpectrumKind::Unbounded);
     c.k = spectrum_texture(params, prefix + "k", std::nullopt, SpectrumKind::Unbounded);
     if (c.reflectance && (c.eta || c.k))
-      throw SceneLoadError(where, type + ": \"reflectance\" cannot be combined with \"eta\" or \"k\"");
+      throw SceneLoadError(where,
+                           type + ": \"reflectance\" cannot be combined with \"eta\" or \"k\"");
     if (!c.reflectance) {
-      if (!c.eta) c.eta = make_constant_texture(named_spectrum("metal-Cu-eta").value_or(Rgb(0.2f, 0.92f, 1.1f)));
-      if (!c.k) c.k = make_constant_texture(named_spectrum("metal-Cu-k").value_or(Rgb(3.9f, 2.45f, 2.14f)));
+      if (!c.eta)
+        c.eta =
+            make_constant_texture(named_spectrum("metal-Cu-eta").value_or(Rgb(0.2f, 0.92f, 1.1f)));
+      if (!c.k)
+        c.k = make_constant_texture(named_spectrum("metal-Cu-k").value_or(Rgb(3.9f, 2.45f, 2.14f)));
     }
     if (type == "coatedconductor") {
       c.u_roughness = float_texture(params, "conductor.uroughness", std::nullopt);
@@ -242,7 +282,8 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
       TexturePtr r = float_texture(params, "conductor.roughness", 0.f);
       if (!c.u_roughness) c.u_roughness = r;
       if (!c.v_roughness) c.v_roughness = r;
-      if (is_constant_value(c.u_roughness, 0.f) && is_constant_value(c.v_roughness, 0.f)) c.u_roughness = c.v_roughness = nullptr;
+      if (is_constant_value(c.u_roughness, 0.f) && is_constant_value(c.v_roughness, 0.f))
+        c.u_roughness = c.v_roughness = nullptr;
       c.remap_roughness = params.get_bool("remaproughness", true);
     } else {
       roughness(&c.u_roughness, &c.v_roughness, &c.remap_roughness);
@@ -265,36 +306,46 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
     if (!c.u_roughness) c.u_roughness = c.v_roughness = make_constant_texture(Rgb(0.f));
     const Param* tp = params.find("thickness", {ParamType::Float, ParamType::Texture});
     if (tp && tp->type == ParamType::Texture)
-      ctx_.warnings.warn(tp->where, "textured coating thickness is not supported; using 0.01", "textured thickness");
-    else c.thickness = params.get_float("thickness", 0.01f);
+      ctx_.warnings.warn(tp->where, "textured coating thickness is not supported; using 0.01",
+                         "textured thickness");
+    else
+      c.thickness = params.get_float("thickness", 0.01f);
     c.eta = check_eta(eta_value(1.5f));
     c.albedo = spectrum_texture(params, "albedo", Rgb(0.f), SpectrumKind::Albedo);
     c.g = float_texture(params, "g", 0.f);
     c.max_depth = params.get_int("maxdepth", 10);
     c.n_samples = params.get_int("nsamples", 1);
     if (c.max_depth < 1 || c.n_samples < 1 || c.max_depth > 1000 || c.n_samples > 1000)
-      throw SceneLoadError(where, "coateddiffuse: maxdepth and nsamples must be between 1 and 1000");
+      throw SceneLoadError(where,
+                           "coateddiffuse: maxdepth and nsamples must be between 1 and 1000");
     m = make_coated_diffuse(c);
   } else if (type == "diffusetransmission") {
-    m = make_diffuse_transmission(spectrum_texture(params, "reflectance", Rgb(0.25f), SpectrumKind::Albedo),
-                                  spectrum_texture(params, "transmittance", Rgb(0.25f), SpectrumKind::Albedo),
-                                  params.get_float("scale", 1));
+    m = make_diffuse_transmission(
+        spectrum_texture(params, "reflectance", Rgb(0.25f), SpectrumKind::Albedo),
+        spectrum_texture(params, "transmittance", Rgb(0.25f), SpectrumKind::Albedo),
+        params.get_float("scale", 1));
   } else if (type == "mix") {
     const Param* mp = params.find("materials", {ParamType::String});
-    if (!mp || mp->strings.size() != 2) throw SceneLoadError(mp ? mp->where : where, "mix: \"string materials\" must name exactly two materials");
+    if (!mp || mp->strings.size() != 2)
+      throw SceneLoadError(mp ? mp->where : where,
+                           "mix: \"string materials\" must name exactly two materials");
     MaterialPtr a = named(mp->strings[0], mp->where), b = named(mp->strings[1], mp->where);
     TexturePtr amount = float_texture(params, "amount", 0.5f);
-    if (!a && !b) m = nullptr;
+    if (!a && !b)
+      m = nullptr;
     else if (!a || !b) {
-      ctx_.warnings.warn(where, "mix with an interface material is not supported; using the other material");
+      ctx_.warnings.warn(
+          where, "mix with an interface material is not supported; using the other material");
       m = a ? a : b;
     } else {
       m = make_mix(a, b, amount);
     }
   } else if (type == "measured" || type == "hair" || type == "subsurface") {
-    ctx_.warnings.warn(where, "material \"" + type + "\" is not supported; using diffuse", "material " + type);
+    ctx_.warnings.warn(where, "material \"" + type + "\" is not supported; using diffuse",
+                       "material " + type);
     TexturePtr r;
-    if (type == "subsurface") r = spectrum_texture(params, "reflectance", std::nullopt, SpectrumKind::Albedo);
+    if (type == "subsurface")
+      r = spectrum_texture(params, "reflectance", std::nullopt, SpectrumKind::Albedo);
     for (const Param& p : params.all()) p.used = true;
     m = make_diffuse(r ? r : make_constant_texture(Rgb(0.5f)));
   } else {

@@ -30,25 +30,30 @@ class MaterialFactory {
   explicit MaterialFactory(LoaderContext& ctx) : ctx_(ctx) {}
 
   // The Texture directive: `type` is "float" or "spectrum".
-  void define_texture(const std::string& name, const std::string& type, const std::string& cls, const ParamList& params,
-                      const SourceLocation& where, const SourceLocation& name_where);
+  void define_texture(const std::string& name, const std::string& type, const std::string& cls,
+                      const ParamList& params, const SourceLocation& where,
+                      const SourceLocation& name_where);
 
   // Looks up named materials for "mix" (and detects cycles in the caller).
-  using NamedMaterialLookup = std::function<MaterialPtr(const std::string& name, const SourceLocation& where)>;
+  using NamedMaterialLookup =
+      std::function<MaterialPtr(const std::string& name, const SourceLocation& where)>;
   // Returns null for "interface" (and "" / "none"): a boundary that does not scatter.
-  MaterialPtr make_material(const std::string& type, const ParamList& params, const SourceLocation& where,
-                            const NamedMaterialLookup& named);
+  MaterialPtr make_material(const std::string& type, const ParamList& params,
+                            const SourceLocation& where, const NamedMaterialLookup& named);
 
   // A colour parameter (rgb, spectrum, blackbody or a spectrum texture); null if absent and
   // there is no default.
-  TexturePtr spectrum_texture(const ParamList& params, const std::string& name, std::optional<Rgb> def, SpectrumKind kind);
+  TexturePtr spectrum_texture(const ParamList& params, const std::string& name,
+                              std::optional<Rgb> def, SpectrumKind kind);
   // A scalar parameter (float or a float texture); null if absent and no default.
-  TexturePtr float_texture(const ParamList& params, const std::string& name, std::optional<float> def);
+  TexturePtr float_texture(const ParamList& params, const std::string& name,
+                           std::optional<float> def);
 
   std::shared_ptr<const Image> load_image(const std::string& path, bool srgb, const Param& where);
 
  private:
-  TexturePtr texture_param(const ParamList& params, const std::string& name, bool is_float, Rgb def);
+  TexturePtr texture_param(const ParamList& params, const std::string& name, bool is_float,
+                           Rgb def);
 
   LoaderContext& ctx_;
   std::map<std::string, TexturePtr> float_textures_, spectrum_textures_;

@@ -13,13 +13,23 @@ struct TypeInfo {
   ParamType type;
 };
 constexpr TypeInfo kTypes[] = {
-    {"integer", ParamType::Integer}, {"float", ParamType::Float},     {"point2", ParamType::Point2},
-    {"vector2", ParamType::Vector2}, {"point3", ParamType::Point3},   {"vector3", ParamType::Vector3},
-    {"normal3", ParamType::Normal3}, {"rgb", ParamType::Rgb},         {"spectrum", ParamType::Spectrum},
-    {"blackbody", ParamType::Blackbody}, {"bool", ParamType::Bool},   {"string", ParamType::String},
+    {"integer", ParamType::Integer},
+    {"float", ParamType::Float},
+    {"point2", ParamType::Point2},
+    {"vector2", ParamType::Vector2},
+    {"point3", ParamType::Point3},
+    {"vector3", ParamType::Vector3},
+    {"normal3", ParamType::Normal3},
+    {"rgb", ParamType::Rgb},
+    {"spectrum", ParamType::Spectrum},
+    {"blackbody", ParamType::Blackbody},
+    {"bool", ParamType::Bool},
+    {"string", ParamType::String},
     {"texture", ParamType::Texture},
     // Aliases accepted by pbrt-v4 (and pbrt-v3 files).
-    {"point", ParamType::Point3},    {"vector", ParamType::Vector3},  {"normal", ParamType::Normal3},
+    {"point", ParamType::Point3},
+    {"vector", ParamType::Vector3},
+    {"normal", ParamType::Normal3},
     {"color", ParamType::Rgb},
 };
 
@@ -28,14 +38,18 @@ int tuple_size(ParamType t) {
   switch (t) {
     case ParamType::Integer:
     case ParamType::Float:
-    case ParamType::Blackbody: return 1;
+    case ParamType::Blackbody:
+      return 1;
     case ParamType::Point2:
-    case ParamType::Vector2: return 2;
+    case ParamType::Vector2:
+      return 2;
     case ParamType::Point3:
     case ParamType::Vector3:
     case ParamType::Normal3:
-    case ParamType::Rgb: return 3;
-    default: return 0;
+    case ParamType::Rgb:
+      return 3;
+    default:
+      return 0;
   }
 }
 
@@ -84,14 +98,20 @@ ParamList ParamList::parse(Tokenizer& tokens) {
       }
     }
     if (words.size() != 2)
-      throw SceneLoadError(p.where, "expected a parameter declaration \"type name\" (such as \"float fov\"), got \"" +
-                                        decl.text + "\"");
+      throw SceneLoadError(
+          p.where,
+          "expected a parameter declaration \"type name\" (such as \"float fov\"), got \"" +
+              decl.text + "\"");
     const auto type = parse_type_name(words[0]);
-    if (!type) throw SceneLoadError(p.where, "unknown parameter type \"" + words[0] + "\" in \"" + decl.text + "\"");
+    if (!type)
+      throw SceneLoadError(p.where,
+                           "unknown parameter type \"" + words[0] + "\" in \"" + decl.text + "\"");
     p.type = *type;
     p.name = words[1];
     for (const Param& q : list.params_)
-      if (q.name == p.name) throw SceneLoadError(p.where, "parameter \"" + p.name + "\" given twice (first at " + q.where.str() + ")");
+      if (q.name == p.name)
+        throw SceneLoadError(
+            p.where, "parameter \"" + p.name + "\" given twice (first at " + q.where.str() + ")");
 
     // Values: one bare value or a bracketed list.
     std::vector<Token> values;
@@ -101,65 +121,88 @@ ParamList ParamList::parse(Tokenizer& tokens) {
         Token v = tokens.next();
         if (v.kind == Token::Kind::CloseBracket) break;
         if (v.kind == Token::Kind::End)
-          throw SceneLoadError(tokens.location(first), "missing \"]\" to close the \"[\" of " + p.declaration());
+          throw SceneLoadError(tokens.location(first),
+                               "missing \"]\" to close the \"[\" of " + p.declaration());
         if (v.kind == Token::Kind::OpenBracket)
-          throw SceneLoadError(tokens.location(v), p.declaration() + ": unexpected \"[\" inside a value list");
+          throw SceneLoadError(tokens.location(v),
+                               p.declaration() + ": unexpected \"[\" inside a value list");
         values.push_back(std::move(v));
       }
     } else if (first.kind == Token::Kind::Word || first.kind == Token::Kind::String) {
       values.push_back(first);
     } else {
-      throw SceneLoadError(tokens.location(first), p.declaration() + ": expected a value or \"[\", got " + describe(first));
+      throw SceneLoadError(tokens.location(first),
+                           p.declaration() + ": expected a value or \"[\", got " + describe(first));
     }
 
     const int tuple = tuple_size(p.type);
     auto expect_number = [&](const Token& v) {
       double d = 0;
       if (v.kind != Token::Kind::Word || !parse_number(v.text, &d))
-        throw SceneLoadError(tokens.location(v), p.declaration() + ": expected a number, got " + describe(v));
+        throw SceneLoadError(tokens.location(v),
+                             p.declaration() + ": expected a number, got " + describe(v));
       return d;
     };
     if (tuple > 0) {
       for (const Token& v : values) {
         const double d = expect_number(v);
         if (p.type == ParamType::Integer &&
-            (d != std::floor(d) || d < std::numeric_limits<int>::min() || d > std::numeric_limits<int>::max()))
-          throw SceneLoadError(tokens.location(v), p.declaration() + ": expected an integer, got " + describe(v));
+            (d != std::floor(d) || d < std::numeric_limits<int>::min() ||
+             d > std::numeric_limits<int>::max()))
+          throw SceneLoadError(tokens.location(v),
+                               p.declaration() + ": expected an integer, got " + describe(v));
         p.numbers.push_back(d);
       }
       if (values.empty() || values.size() % tuple != 0) {
-        std::string what = tuple == 1 ? "at least one value" : "a multiple of " + std::to_string(tuple) + " values";
+        std::string what = tuple == 1 ? "at least one value"
+                                      : "a multiple of " + std::to_string(tuple) + " values";
         if (p.type == ParamType::Rgb || p.type == ParamType::Blackbody)
-          what = p.type == ParamType::Rgb ? "exactly 3 values" : "exactly 1 value (a temperature in kelvin)";
-        throw SceneLoadError(p.where, p.declaration() + ": expected " + what + ", got " + std::to_string(values.size()));
+          what = p.type == ParamType::Rgb ? "exactly 3 values"
+                                          : "exactly 1 value (a temperature in kelvin)";
+        throw SceneLoadError(p.where, p.declaration() + ": expected " + what + ", got " +
+                                          std::to_string(values.size()));
       }
-      if ((p.type == ParamType::Rgb && values.size() != 3) || (p.type == ParamType::Blackbody && values.size() != 1))
-        throw SceneLoadError(p.where, p.declaration() + ": expected " +
-                                          std::string(p.type == ParamType::Rgb ? "exactly 3 values" : "exactly 1 value (a temperature in kelvin)") +
-                                          ", got " + std::to_string(values.size()));
+      if ((p.type == ParamType::Rgb && values.size() != 3) ||
+          (p.type == ParamType::Blackbody && values.size() != 1))
+        throw SceneLoadError(p.where,
+                             p.declaration() + ": expected " +
+                                 std::string(p.type == ParamType::Rgb
+                                                 ? "exactly 3 values"
+                                                 : "exactly 1 value (a temperature in kelvin)") +
+                                 ", got " + std::to_string(values.size()));
     } else if (p.type == ParamType::Bool) {
       for (const Token& v : values) {
-        if (v.text == "true") p.bools.push_back(true);
-        else if (v.text == "false") p.bools.push_back(false);
-        else throw SceneLoadError(tokens.location(v), p.declaration() + ": expected true or false, got " + describe(v));
+        if (v.text == "true")
+          p.bools.push_back(true);
+        else if (v.text == "false")
+          p.bools.push_back(false);
+        else
+          throw SceneLoadError(tokens.location(v),
+                               p.declaration() + ": expected true or false, got " + describe(v));
       }
-      if (p.bools.empty()) throw SceneLoadError(p.where, p.declaration() + ": expected at least one value, got 0");
+      if (p.bools.empty())
+        throw SceneLoadError(p.where, p.declaration() + ": expected at least one value, got 0");
     } else if (p.type == ParamType::String || p.type == ParamType::Texture) {
       for (const Token& v : values) {
         if (v.kind != Token::Kind::String)
-          throw SceneLoadError(tokens.location(v), p.declaration() + ": expected a quoted string, got " + describe(v));
+          throw SceneLoadError(tokens.location(v),
+                               p.declaration() + ": expected a quoted string, got " + describe(v));
         p.strings.push_back(v.text);
       }
-      if (p.strings.empty()) throw SceneLoadError(p.where, p.declaration() + ": expected at least one value, got 0");
+      if (p.strings.empty())
+        throw SceneLoadError(p.where, p.declaration() + ": expected at least one value, got 0");
     } else {  // spectrum: (lambda, value) pairs, or one string (a named spectrum or a file)
       if (!values.empty() && values[0].kind == Token::Kind::String) {
         if (values.size() != 1)
-          throw SceneLoadError(tokens.location(values[1]), p.declaration() + ": expected one spectrum name, got " + describe(values[1]));
+          throw SceneLoadError(
+              tokens.location(values[1]),
+              p.declaration() + ": expected one spectrum name, got " + describe(values[1]));
         p.strings.push_back(values[0].text);
       } else {
         for (const Token& v : values) p.numbers.push_back(expect_number(v));
         if (p.numbers.size() < 2 || p.numbers.size() % 2 != 0)
-          throw SceneLoadError(p.where, p.declaration() + ": expected (wavelength, value) pairs, got " +
+          throw SceneLoadError(p.where, p.declaration() +
+                                            ": expected (wavelength, value) pairs, got " +
                                             std::to_string(p.numbers.size()) + " numbers");
         for (size_t i = 2; i < p.numbers.size(); i += 2)
           if (p.numbers[i] <= p.numbers[i - 2])
@@ -191,11 +234,13 @@ const Param* ParamList::find(std::string_view name, std::initializer_list<ParamT
 }
 
 namespace {
-const Param* single(const ParamList& list, std::string_view name, std::initializer_list<ParamType> types, size_t count) {
+const Param* single(const ParamList& list, std::string_view name,
+                    std::initializer_list<ParamType> types, size_t count) {
   const Param* p = list.find(name, types);
   if (!p) return nullptr;
   const size_t n = p->numbers.size() + p->strings.size() + p->bools.size();
-  if (n != count) param_error(*p, "expected one value, got " + std::to_string(n / std::max<size_t>(count, 1)));
+  if (n != count)
+    param_error(*p, "expected one value, got " + std::to_string(n / std::max<size_t>(count, 1)));
   return p;
 }
 }  // namespace
@@ -250,20 +295,27 @@ std::vector<Vec3> triples(const Param* p) {
   return out;
 }
 }  // namespace
-std::vector<Vec3> ParamList::get_point3s(std::string_view name) const { return triples(find(name, {ParamType::Point3})); }
-std::vector<Vec3> ParamList::get_normals(std::string_view name) const { return triples(find(name, {ParamType::Normal3})); }
+std::vector<Vec3> ParamList::get_point3s(std::string_view name) const {
+  return triples(find(name, {ParamType::Point3}));
+}
+std::vector<Vec3> ParamList::get_normals(std::string_view name) const {
+  return triples(find(name, {ParamType::Normal3}));
+}
 std::vector<Vec2> ParamList::get_point2s(std::string_view name) const {
   std::vector<Vec2> out;
   if (const Param* p = find(name, {ParamType::Point2}))
-    for (size_t i = 0; i + 1 < p->numbers.size(); i += 2) out.emplace_back(float(p->numbers[i]), float(p->numbers[i + 1]));
+    for (size_t i = 0; i + 1 < p->numbers.size(); i += 2)
+      out.emplace_back(float(p->numbers[i]), float(p->numbers[i + 1]));
   return out;
 }
 
 void ParamList::report_unused(Warnings& warnings, const std::string& context) const {
   for (const Param& p : params_)
     if (!p.used)
-      warnings.warn(p.where, context + ": parameter " + p.declaration() + " is unknown or not supported; ignored",
-                    "unused " + context + " " + p.declaration());
+      warnings.warn(
+          p.where,
+          context + ": parameter " + p.declaration() + " is unknown or not supported; ignored",
+          "unused " + context + " " + p.declaration());
 }
 
 }  // namespace caustica::pbrt

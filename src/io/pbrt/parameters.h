@@ -18,7 +18,21 @@ namespace caustica::pbrt {
 
 // The pbrt-v4 parameter types. Aliases are folded when parsed: point -> point3,
 // vector -> vector3, normal -> normal3, color -> rgb.
-enum class ParamType { Integer, Float, Point2, Vector2, Point3, Vector3, Normal3, Rgb, Spectrum, Blackbody, Bool, String, Texture };
+enum class ParamType {
+  Integer,
+  Float,
+  Point2,
+  Vector2,
+  Point3,
+  Vector3,
+  Normal3,
+  Rgb,
+  Spectrum,
+  Blackbody,
+  Bool,
+  String,
+  Texture
+};
 
 const char* type_name(ParamType type);
 std::optional<ParamType> parse_type_name(std::string_view name);
@@ -26,13 +40,16 @@ std::optional<ParamType> parse_type_name(std::string_view name);
 struct Param {
   ParamType type = ParamType::Float;
   std::string name;
-  SourceLocation where;            // of the "type name" string
-  std::vector<double> numbers;     // integer, float, point*, vector*, normal, rgb, blackbody, spectrum (lambda, value pairs)
+  SourceLocation where;         // of the "type name" string
+  std::vector<double> numbers;  // integer, float, point*, vector*, normal, rgb, blackbody, spectrum
+                                // (lambda, value pairs)
   std::vector<std::string> strings;  // string, texture, spectrum (a named spectrum or file)
   std::vector<bool> bools;
   mutable bool used = false;
 
-  std::string declaration() const { return std::string("\"") + type_name(type) + " " + name + "\""; }
+  std::string declaration() const {
+    return std::string("\"") + type_name(type) + " " + name + "\"";
+  }
 };
 
 class ParamList {

@@ -15,11 +15,12 @@
 namespace caustica::pbrt {
 
 struct Directive {
-  std::string name;                  // "Shape", "Translate", ...
-  SourceLocation where;              // of the directive's name
-  std::vector<std::string> args;     // quoted or bare-word arguments: Shape "sphere" -> {"sphere"}
+  std::string name;               // "Shape", "Translate", ...
+  SourceLocation where;           // of the directive's name
+  std::vector<std::string> args;  // quoted or bare-word arguments: Shape "sphere" -> {"sphere"}
   std::vector<SourceLocation> arg_where;
-  std::vector<float> numbers;        // Translate/Scale/Rotate/LookAt/Transform/ConcatTransform/TransformTimes
+  std::vector<float>
+      numbers;  // Translate/Scale/Rotate/LookAt/Transform/ConcatTransform/TransformTimes
   ParamList params;
 };
 

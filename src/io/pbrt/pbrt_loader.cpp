@@ -18,8 +18,8 @@ std::optional<std::string> read_text_file(const std::string& path) {
   return s.str();
 }
 
-void convert(const std::string& text, const std::string& name, SceneBuilder& builder, pbrt::LoaderContext& ctx,
-             const pbrt::ParseOptions& options) {
+void convert(const std::string& text, const std::string& name, SceneBuilder& builder,
+             pbrt::LoaderContext& ctx, const pbrt::ParseOptions& options) {
   pbrt::Tokenizer tokens(text, name);
   pbrt::SceneConverter converter(builder, ctx);
   pbrt::parse_directives(tokens, converter, options);
@@ -40,15 +40,16 @@ std::unique_ptr<Scene> load_pbrt(const std::string& path, WarningSink warn) {
   return builder.build(std::filesystem::path(path).stem().string());
 }
 
-void parse_pbrt_string(const std::string& text, const std::string& name, SceneBuilder& builder, WarningSink warn,
-                       size_t max_triangles) {
+void parse_pbrt_string(const std::string& text, const std::string& name, SceneBuilder& builder,
+                       WarningSink warn, size_t max_triangles) {
   pbrt::LoaderContext ctx(warn);
   ctx.allow_files = false;
   ctx.max_triangles = max_triangles;
   convert(text, name, builder, ctx, pbrt::ParseOptions{});
 }
 
-std::unique_ptr<Scene> load_pbrt_string(const std::string& text, WarningSink warn, const std::string& name) {
+std::unique_ptr<Scene> load_pbrt_string(const std::string& text, WarningSink warn,
+                                        const std::string& name) {
   SceneBuilder builder;
   parse_pbrt_string(text, name, builder, warn);
   return builder.build(name);

@@ -20,10 +20,11 @@ std::unique_ptr<Scene> load_pbrt(const std::string& path, WarningSink warn);
 // touching the file system: Include, plymesh, imagemap and other file references are
 // errors. `name` is the file name used in messages. A nonzero `max_triangles` bounds the
 // geometry (for fuzzing). Throws SceneLoadError.
-void parse_pbrt_string(const std::string& text, const std::string& name, SceneBuilder& builder, WarningSink warn,
-                       size_t max_triangles = 0);
+void parse_pbrt_string(const std::string& text, const std::string& name, SceneBuilder& builder,
+                       WarningSink warn, size_t max_triangles = 0);
 
 // parse_pbrt_string, then build (for tests).
-std::unique_ptr<Scene> load_pbrt_string(const std::string& text, WarningSink warn, const std::string& name = "<string>");
+std::unique_ptr<Scene> load_pbrt_string(const std::string& text, WarningSink warn,
+                                        const std::string& name = "<string>");
 
 }  // namespace caustica

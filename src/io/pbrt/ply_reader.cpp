@@ -16,11 +16,16 @@ namespace {
 enum class Scalar { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
 
 bool parse_scalar(const std::string& s, Scalar* out) {
-  static const struct { const char* name; Scalar type; } names[] = {
-      {"char", Scalar::Int8},    {"int8", Scalar::Int8},     {"uchar", Scalar::UInt8},  {"uint8", Scalar::UInt8},
-      {"short", Scalar::Int16},  {"int16", Scalar::Int16},   {"ushort", Scalar::UInt16}, {"uint16", Scalar::UInt16},
-      {"int", Scalar::Int32},    {"int32", Scalar::Int32},   {"uint", Scalar::UInt32},  {"uint32", Scalar::UInt32},
-      {"float", Scalar::Float32}, {"float32", Scalar::Float32}, {"double", Scalar::Float64}, {"float64", Scalar::Float64}};
+  static const struct {
+    const char* name;
+    Scalar type;
+  } names[] = {
+      {"char", Scalar::Int8},      {"int8", Scalar::Int8},       {"uchar", Scalar::UInt8},
+      {"uint8", Scalar::UInt8},    {"short", Scalar::Int16},     {"int16", Scalar::Int16},
+      {"ushort", Scalar::UInt16},  {"uint16", Scalar::UInt16},   {"int", Scalar::Int32},
+      {"int32", Scalar::Int32},    {"uint", Scalar::UInt32},     {"uint32", Scalar::UInt32},
+      {"float", Scalar::Float32},  {"float32", Scalar::Float32}, {"double", Scalar::Float64},
+      {"float64", Scalar::Float64}};
   for (const auto& n : names)
     if (s == n.name) {
       *out = n.type;
@@ -31,10 +36,18 @@ bool parse_scalar(const std::string& s, Scalar* out) {
 
 size_t scalar_size(Scalar s) {
   switch (s) {
-    case Scalar::Int8: case Scalar::UInt8: return 1;
-    case Scalar::Int16: case Scalar::UInt16: return 2;
-    case Scalar::Int32: case Scalar::UInt32: case Scalar::Float32: return 4;
-    case Scalar::Float64: return 8;
+    case Scalar::Int8:
+    case Scalar::UInt8:
+      return 1;
+    case Scalar::Int16:
+    case Scalar::UInt16:
+      return 2;
+    case Scalar::Int32:
+    case Scalar::UInt32:
+    case Scalar::Float32:
+      return 4;
+    case Scalar::Float64:
+      return 8;
   }
   return 1;
 }
@@ -59,7 +72,8 @@ enum class Format { Ascii, BinaryLittle, BinaryBig };
 // Sequential reader of element data in any of the three formats.
 class DataReader {
  public:
-  DataReader(const std::string& data, size_t pos, Format format) : data_(data), pos_(pos), format_(format) {}
+  DataReader(const std::string& data, size_t pos, Format format)
+      : data_(data), pos_(pos), format_(format) {}
 
   double read(Scalar type, const char* what) {
     if (format_ == Format::Ascii) return read_ascii(what);
@@ -68,18 +82,48 @@ class DataReader {
     unsigned char b[8];
     std::memcpy(b, data_.data() + pos_, n);
     pos_ += n;
-    const bool swap = (format_ == Format::BinaryBig) == (std::endian::native == std::endian::little);
+    const bool swap =
+        (format_ == Format::BinaryBig) == (std::endian::native == std::endian::little);
     if (swap)
       for (size_t i = 0; i < n / 2; ++i) std::swap(b[i], b[n - 1 - i]);
     switch (type) {
-      case Scalar::Int8: { int8_t v; std::memcpy(&v, b, 1); return v; }
-      case Scalar::UInt8: return b[0];
-      case Scalar::Int16: { int16_t v; std::memcpy(&v, b, 2); return v; }
-      case Scalar::UInt16: { uint16_t v; std::memcpy(&v, b, 2); return v; }
-      case Scalar::Int32: { int32_t v; std::memcpy(&v, b, 4); return v; }
-      case Scalar::UInt32: { uint32_t v; std::memcpy(&v, b, 4); return v; }
-      case Scalar::Float32: { float v; std::memcpy(&v, b, 4); return v; }
-      case Scalar::Float64: { double v; std::memcpy(&v, b, 8); return v; }
+      case Scalar::Int8: {
+        int8_t v;
+        std::memcpy(&v, b, 1);
+        return v;
+      }
+      case Scalar::UInt8:
+        return b[0];
+      case Scalar::Int16: {
+        int16_t v;
+        std::memcpy(&v, b, 2);
+        return v;
+      }
+      case Scalar::UInt16: {
+        uint16_t v;
+        std::memcpy(&v, b, 2);
+        return v;
+      }
+      case Scalar::Int32: {
+        int32_t v;
+        std::memcpy(&v, b, 4);
+        return v;
+      }
+      case Scalar::UInt32: {
+        uint32_t v;
+        std::memcpy(&v, b, 4);
+        return v;
+      }
+      case Scalar::Float32: {
+        float v;
+        std::memcpy(&v, b, 4);
+        return v;
+      }
+      case Scalar::Float64: {
+        double v;
+        std::memcpy(&v, b, 8);
+        return v;
+      }
     }
     return 0;
   }
@@ -98,7 +142,8 @@ class DataReader {
     double v = 0;
     const auto [ptr, ec] = std::from_chars(first, last, v);
     if (ec != std::errc() || ptr != last)
-      fail(std::string("expected a number in ") + what + ", got \"" + data_.substr(pos_, std::min<size_t>(end - pos_, 32)) + "\"");
+      fail(std::string("expected a number in ") + what + ", got \"" +
+           data_.substr(pos_, std::min<size_t>(end - pos_, 32)) + "\"");
     pos_ = end;
     return v;
   }
@@ -107,6 +152,15 @@ class DataReader {
   size_t pos_;
   Format format_;
 };
+
+// A list's length: a non-negative integer that the remaining data could hold (every item
+// takes at least one byte or one character), so a corrupt count cannot make us loop long.
+size_t list_length(DataReader& reader, Scalar count_type, const char* what) {
+  const double n = reader.read(count_type, what);
+  if (!(n >= 0) || n != std::floor(n) || n > double(reader.remaining()))
+    fail(std::string("invalid list length ") + std::to_string(n) + " in " + what);
+  return size_t(n);
+}
 
 }  // namespace
 
@@ -142,10 +196,14 @@ PlyMesh parse_ply(const std::string& data) {
     if (keyword == "format") {
       std::string f, version;
       in >> f >> version;
-      if (f == "ascii") format = Format::Ascii;
-      else if (f == "binary_little_endian") format = Format::BinaryLittle;
-      else if (f == "binary_big_endian") format = Format::BinaryBig;
-      else fail(at + ": unknown format \"" + f + "\"");
+      if (f == "ascii")
+        format = Format::Ascii;
+      else if (f == "binary_little_endian")
+        format = Format::BinaryLittle;
+      else if (f == "binary_big_endian")
+        format = Format::BinaryBig;
+      else
+        fail(at + ": unknown format \"" + f + "\"");
       have_format = true;
     } else if (keyword == "element") {
       Element e;
@@ -189,14 +247,22 @@ PlyMesh parse_ply(const std::string& data) {
       for (int i = 0; i < int(e.properties.size()); ++i) {
         const std::string& n = e.properties[i].name;
         if (e.properties[i].is_list) continue;
-        if (n == "x") ix = i;
-        else if (n == "y") iy = i;
-        else if (n == "z") iz = i;
-        else if (n == "nx") inx = i;
-        else if (n == "ny") iny = i;
-        else if (n == "nz") inz = i;
-        else if (n == "u" || n == "s" || n == "texture_u" || n == "texture_s") iu = i;
-        else if (n == "v" || n == "t" || n == "texture_v" || n == "texture_t") iv = i;
+        if (n == "x")
+          ix = i;
+        else if (n == "y")
+          iy = i;
+        else if (n == "z")
+          iz = i;
+        else if (n == "nx")
+          inx = i;
+        else if (n == "ny")
+          iny = i;
+        else if (n == "nz")
+          inz = i;
+        else if (n == "u" || n == "s" || n == "texture_u" || n == "texture_s")
+          iu = i;
+        else if (n == "v" || n == "t" || n == "texture_v" || n == "texture_t")
+          iv = i;
       }
       if (ix < 0 || iy < 0 || iz < 0) fail("the vertex element has no x, y and z properties");
       const bool normals = inx >= 0 && iny >= 0 && inz >= 0, uvs = iu >= 0 && iv >= 0;
@@ -210,21 +276,22 @@ PlyMesh parse_ply(const std::string& data) {
         for (size_t i = 0; i < e.properties.size(); ++i) {
           const Property& p = e.properties[i];
           if (p.is_list) {
-            const double n = reader.read(p.count_type, "vertex data");
-            if (n < 0) fail("negative list length in vertex data");
-            for (size_t k = 0; k < size_t(n); ++k) reader.read(p.type, "vertex data");
+            const size_t n = list_length(reader, p.count_type, "vertex data");
+            for (size_t k = 0; k < n; ++k) reader.read(p.type, "vertex data");
             continue;
           }
           values[i] = reader.read(p.type, "vertex data");
         }
         mesh.positions.emplace_back(float(values[ix]), float(values[iy]), float(values[iz]));
-        if (normals) mesh.normals.emplace_back(float(values[inx]), float(values[iny]), float(values[inz]));
+        if (normals)
+          mesh.normals.emplace_back(float(values[inx]), float(values[iny]), float(values[inz]));
         if (uvs) mesh.uvs.emplace_back(float(values[iu]), float(values[iv]));
       }
     } else if (e.name == "face") {
       int index_property = -1;
       for (int i = 0; i < int(e.properties.size()); ++i)
-        if (e.properties[i].is_list && (e.properties[i].name == "vertex_indices" || e.properties[i].name == "vertex_index"))
+        if (e.properties[i].is_list &&
+            (e.properties[i].name == "vertex_indices" || e.properties[i].name == "vertex_index"))
           index_property = i;
       if (index_property < 0) fail("the face element has no vertex_indices list");
       mesh.indices.reserve(std::min(e.count, reader.remaining() + 1) * 3);
@@ -236,21 +303,21 @@ PlyMesh parse_ply(const std::string& data) {
             reader.read(p.type, "face data");
             continue;
           }
-          const double n = reader.read(p.count_type, "face data");
-          if (n < 0) fail("negative list length in face data");
-          const size_t count = size_t(n);
+          const size_t count = list_length(reader, p.count_type, "face data");
           for (size_t k = 0; k < count; ++k) {
             const double idx = reader.read(p.type, "face data");
             if (i != index_property) continue;
             if (!(idx >= 0 && idx < 4294967295.0) || idx != std::floor(idx))
-              fail("face " + std::to_string(f) + " has an invalid vertex index " + std::to_string(idx));
+              fail("face " + std::to_string(f) + " has an invalid vertex index " +
+                   std::to_string(idx));
             if (k < 4) face[k] = uint32_t(idx);
           }
           if (i != index_property) continue;
           if (count == 3) {
             mesh.indices.insert(mesh.indices.end(), {face[0], face[1], face[2]});
           } else if (count == 4) {
-            mesh.indices.insert(mesh.indices.end(), {face[0], face[1], face[2], face[0], face[2], face[3]});
+            mesh.indices.insert(mesh.indices.end(),
+                                {face[0], face[1], face[2], face[0], face[2], face[3]});
           } else {
             ++mesh.skipped_faces;
           }
@@ -262,9 +329,8 @@ PlyMesh parse_ply(const std::string& data) {
       for (size_t k = 0; k < e.count; ++k)
         for (const Property& p : e.properties) {
           if (p.is_list) {
-            const double n = reader.read(p.count_type, "element data");
-            if (n < 0) fail("negative list length in element \"" + e.name + "\"");
-            for (size_t j = 0; j < size_t(n); ++j) reader.read(p.type, "element data");
+            const size_t n = list_length(reader, p.count_type, "element data");
+            for (size_t j = 0; j < n; ++j) reader.read(p.type, "element data");
           } else {
             reader.read(p.type, "element data");
           }
@@ -274,7 +340,8 @@ PlyMesh parse_ply(const std::string& data) {
   if (!have_vertices) fail("the file has no vertex element");
   for (uint32_t i : mesh.indices)
     if (i >= mesh.positions.size())
-      fail("vertex index " + std::to_string(i) + " is out of range (" + std::to_string(mesh.positions.size()) + " vertices)");
+      fail("vertex index " + std::to_string(i) + " is out of range (" +
+           std::to_string(mesh.positions.size()) + " vertices)");
   return mesh;
 }
 

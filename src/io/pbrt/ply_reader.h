@@ -17,7 +17,7 @@ struct PlyMesh {
   std::vector<Vec3> normals;  // empty if the file has none
   std::vector<Vec2> uvs;      // empty if the file has none
   std::vector<uint32_t> indices;
-  size_t skipped_faces = 0;   // faces with fewer than 3 or more than 4 vertices
+  size_t skipped_faces = 0;  // faces with fewer than 3 or more than 4 vertices
 };
 
 // Parses PLY data held in memory. Throws std::runtime_error with a message that says what

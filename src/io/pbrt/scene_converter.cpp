@@ -46,9 +46,10 @@ std::optional<float> similarity_scale(const Transform& t) {
   return s;
 }
 
-std::string integrator_name(const std::string& pbrt_name, const SourceLocation& where, LoaderContext& ctx) {
-  if (pbrt_name == "path" || pbrt_name == "volpath" || pbrt_name == "simplepath" || pbrt_name == "simplevolpath" ||
-      pbrt_name == "randomwalk")
+std::string integrator_name(const std::string& pbrt_name, const SourceLocation& where,
+                            LoaderContext& ctx) {
+  if (pbrt_name == "path" || pbrt_name == "volpath" || pbrt_name == "simplepath" ||
+      pbrt_name == "simplevolpath" || pbrt_name == "randomwalk")
     return "pt";
   if (pbrt_name == "bdpt") return "bpt";
   if (pbrt_name == "lightpath") return "lt";
@@ -95,10 +96,12 @@ void SceneConverter::require_world(const Directive& d, bool inside) const {
   if (inside && !world_)
     throw SceneLoadError(d.where, d.name + " is only allowed after WorldBegin");
   if (!inside && world_)
-    throw SceneLoadError(d.where, d.name + " is only allowed before WorldBegin (it sets a rendering option)");
+    throw SceneLoadError(
+        d.where, d.name + " is only allowed before WorldBegin (it sets a rendering option)");
 }
 
-ParamList SceneConverter::with_attributes(const ParamList& params, const std::string& target) const {
+ParamList SceneConverter::with_attributes(const ParamList& params,
+                                          const std::string& target) const {
   auto it = state_.attributes.find(target);
   if (it == state_.attributes.end()) return params;
   ParamList merged = params;
@@ -136,7 +139,8 @@ void SceneConverter::handle(const Directive& d) {
   }
   if (n == "Rotate") {
     const Vec3 axis(v[1], v[2], v[3]);
-    if (!(length(axis) > 0) || !std::isfinite(length(axis))) throw SceneLoadError(d.where, "Rotate: the rotation axis is zero");
+    if (!(length(axis) > 0) || !std::isfinite(length(axis)))
+      throw SceneLoadError(d.where, "Rotate: the rotation axis is zero");
     return apply_transform(d, Transform::rotate(v[0], axis), true);
   }
   if (n == "LookAt") {
@@ -145,11 +149,13 @@ void SceneConverter::handle(const Directive& d) {
     if (!(length(dir) > 0) || !std::isfinite(length(dir)))
       throw SceneLoadError(d.where, "LookAt: the eye and the look-at point are the same");
     if (!(length(up) > 0) || !(length(cross(normalize(up), normalize(dir))) > 1e-6f))
-      throw SceneLoadError(d.where, "LookAt: the up vector is zero or parallel to the viewing direction");
+      throw SceneLoadError(d.where,
+                           "LookAt: the up vector is zero or parallel to the viewing direction");
     return apply_transform(d, Transform::look_at(eye, look, up), true);
   }
   if (n == "Transform" || n == "ConcatTransform")
-    return apply_transform(d, make_transform(Mat4::from_column_major(v.data())), n == "ConcatTransform");
+    return apply_transform(d, make_transform(Mat4::from_column_major(v.data())),
+                           n == "ConcatTransform");
   if (n == "CoordinateSystem") {
     coordinate_systems_[d.args[0]] = state_.ctm;
     return;
@@ -157,7 +163,8 @@ void SceneConverter::handle(const Directive& d) {
   if (n == "CoordSysTransform") {
     auto it = coordinate_systems_.find(d.args[0]);
     if (it == coordinate_systems_.end())
-      ctx_.warnings.warn(d.arg_where[0], "CoordSysTransform: no coordinate system named \"" + d.args[0] + "\"; ignored");
+      ctx_.warnings.warn(d.arg_where[0], "CoordSysTransform: no coordinate system named \"" +
+                                             d.args[0] + "\"; ignored");
     else if (transforms_active_)
       state_.ctm = it->second;
     return;
@@ -168,14 +175,19 @@ void SceneConverter::handle(const Directive& d) {
       transforms_active_ = true;
     } else if (which == "EndTime") {
       transforms_active_ = false;
-      ctx_.warnings.warn(d.where, "motion blur is not supported: transformations for EndTime are ignored", "motion blur");
+      ctx_.warnings.warn(d.where,
+                         "motion blur is not supported: transformations for EndTime are ignored",
+                         "motion blur");
     } else {
-      throw SceneLoadError(d.arg_where[0], "ActiveTransform: expected StartTime, EndTime or All, got \"" + which + "\"");
+      throw SceneLoadError(
+          d.arg_where[0],
+          "ActiveTransform: expected StartTime, EndTime or All, got \"" + which + "\"");
     }
     return;
   }
   if (n == "TransformTimes") {
-    ctx_.warnings.warn(d.where, "motion blur is not supported: TransformTimes is ignored", "motion blur");
+    ctx_.warnings.warn(d.where, "motion blur is not supported: TransformTimes is ignored",
+                       "motion blur");
     return;
   }
   if (n == "ReverseOrientation") {
@@ -194,19 +206,26 @@ void SceneConverter::handle(const Directive& d) {
     if (blocks_.empty()) throw SceneLoadError(d.where, n + " without a matching " + open);
     const Block& b = blocks_.back();
     if (b.kind != kind) {
-      const char* other = b.kind == 'a' ? "AttributeBegin" : b.kind == 't' ? "TransformBegin" : "ObjectBegin";
+      const char* other = b.kind == 'a'   ? "AttributeBegin"
+                          : b.kind == 't' ? "TransformBegin"
+                                          : "ObjectBegin";
       throw SceneLoadError(d.where, n + " does not match the " + other + " at " + b.where.str());
     }
-    if (kind == 'a') state_ = b.saved;
-    else state_.ctm = b.saved.ctm;
+    if (kind == 'a')
+      state_ = b.saved;
+    else
+      state_.ctm = b.saved.ctm;
     blocks_.pop_back();
     return;
   }
   if (n == "Attribute") {
     const std::string& target = d.args[0];
-    if (target != "shape" && target != "light" && target != "material" && target != "medium" && target != "texture")
-      throw SceneLoadError(d.arg_where[0], "Attribute: expected \"shape\", \"light\", \"material\", \"medium\" or \"texture\", got \"" +
-                                               target + "\"");
+    if (target != "shape" && target != "light" && target != "material" && target != "medium" &&
+        target != "texture")
+      throw SceneLoadError(d.arg_where[0],
+                           "Attribute: expected \"shape\", \"light\", \"material\", \"medium\" or "
+                           "\"texture\", got \"" +
+                               target + "\"");
     ParamList& list = state_.attributes[target];
     ParamList updated;
     for (const Param& p : d.params.all()) updated.add(p);
@@ -222,11 +241,13 @@ void SceneConverter::handle(const Directive& d) {
   // Options block.
   if (n == "Camera") {
     require_world(d, false);
-    if (!is_invertible(state_.ctm)) throw SceneLoadError(d.where, "Camera: the current transformation is singular");
+    if (!is_invertible(state_.ctm))
+      throw SceneLoadError(d.where, "Camera: the current transformation is singular");
     camera_from_world_ = state_.ctm;
     coordinate_systems_["camera"] = state_.ctm.inverse();
     if (d.args[0] != "perspective") {
-      ctx_.warnings.warn(d.where, "camera \"" + d.args[0] + "\" is not supported; using \"perspective\"");
+      ctx_.warnings.warn(d.where,
+                         "camera \"" + d.args[0] + "\" is not supported; using \"perspective\"");
       mark_all_used(d.params);
     }
     camera_.fov_degrees = d.params.get_float("fov", 90);
@@ -235,11 +256,15 @@ void SceneConverter::handle(const Directive& d) {
     camera_.lens_radius = d.params.get_float("lensradius", 0);
     camera_.focal_distance = d.params.get_float("focaldistance", 1e6f);
     if (camera_.lens_radius < 0) param_error(*d.params.find("lensradius"), "must not be negative");
-    if (!(camera_.focal_distance > 0)) param_error(*d.params.find("focaldistance"), "must be positive");
+    if (!(camera_.focal_distance > 0))
+      param_error(*d.params.find("focaldistance"), "must be positive");
     if (const Param* sw = d.params.find("screenwindow", {ParamType::Float})) {
-      if (sw->numbers.size() != 4) param_error(*sw, "expected 4 values (xmin xmax ymin ymax), got " + std::to_string(sw->numbers.size()));
+      if (sw->numbers.size() != 4)
+        param_error(*sw, "expected 4 values (xmin xmax ymin ymax), got " +
+                             std::to_string(sw->numbers.size()));
       for (int i = 0; i < 4; ++i) camera_.screen_window[i] = float(sw->numbers[i]);
-      if (!(camera_.screen_window[0] < camera_.screen_window[1] && camera_.screen_window[2] < camera_.screen_window[3]))
+      if (!(camera_.screen_window[0] < camera_.screen_window[1] &&
+            camera_.screen_window[2] < camera_.screen_window[3]))
         param_error(*sw, "expected xmin < xmax and ymin < ymax");
     }
     d.params.report_unused(ctx_.warnings, "Camera \"" + d.args[0] + "\"");
@@ -248,13 +273,16 @@ void SceneConverter::handle(const Directive& d) {
   if (n == "Film") {
     require_world(d, false);
     if (d.args[0] != "rgb" && d.args[0] != "gbuffer" && d.args[0] != "spectral")
-      throw SceneLoadError(d.arg_where[0], "unknown film \"" + d.args[0] + "\" (expected rgb, gbuffer or spectral)");
+      throw SceneLoadError(
+          d.arg_where[0], "unknown film \"" + d.args[0] + "\" (expected rgb, gbuffer or spectral)");
     camera_.width = d.params.get_int("xresolution", 1280);
     camera_.height = d.params.get_int("yresolution", 720);
     for (const char* r : {"xresolution", "yresolution"})
       if (const Param* p = d.params.find(r))
-        if (!(p->numbers[0] >= 1 && p->numbers[0] <= 65536)) param_error(*p, "expected a resolution between 1 and 65536");
-    if (d.params.find("filename")) builder_.settings().output_name = d.params.get_string("filename", "");
+        if (!(p->numbers[0] >= 1 && p->numbers[0] <= 65536))
+          param_error(*p, "expected a resolution between 1 and 65536");
+    if (d.params.find("filename"))
+      builder_.settings().output_name = d.params.get_string("filename", "");
     d.params.report_unused(ctx_.warnings, "Film \"" + d.args[0] + "\"");
     return;
   }
@@ -278,7 +306,9 @@ void SceneConverter::handle(const Directive& d) {
   if (n == "PixelFilter") {
     require_world(d, false);
     if (d.args[0] != "box")
-      ctx_.warnings.warn(d.where, "PixelFilter \"" + d.args[0] + "\" is not supported; using a box filter", "pixel filter");
+      ctx_.warnings.warn(d.where,
+                         "PixelFilter \"" + d.args[0] + "\" is not supported; using a box filter",
+                         "pixel filter");
     mark_all_used(d.params);
     return;
   }
@@ -289,12 +319,14 @@ void SceneConverter::handle(const Directive& d) {
   }
   if (n == "ColorSpace") {
     if (d.args[0] != "srgb")
-      ctx_.warnings.warn(d.where, "ColorSpace \"" + d.args[0] + "\" is not supported; using srgb", "colorspace");
+      ctx_.warnings.warn(d.where, "ColorSpace \"" + d.args[0] + "\" is not supported; using srgb",
+                         "colorspace");
     return;
   }
   if (n == "Option") {
     const Param& p = d.params.all()[0];
-    ctx_.warnings.warn(p.where, "Option " + p.declaration() + " is not supported; ignored", "option " + p.name);
+    ctx_.warnings.warn(p.where, "Option " + p.declaration() + " is not supported; ignored",
+                       "option " + p.name);
     return;
   }
   if (n == "WorldBegin") {
@@ -321,11 +353,13 @@ void SceneConverter::handle(const Directive& d) {
   if (n == "MakeNamedMaterial") {
     const std::string& name = d.args[0];
     if (named_materials_.count(name))
-      throw SceneLoadError(d.arg_where[0], "named material \"" + name + "\" is defined twice (first at " +
-                                              named_materials_[name].where.str() + ")");
+      throw SceneLoadError(d.arg_where[0], "named material \"" + name +
+                                               "\" is defined twice (first at " +
+                                               named_materials_[name].where.str() + ")");
     ParamList params = with_attributes(d.params, "material");
     if (!params.find("type", {ParamType::String}))
-      throw SceneLoadError(d.where, "MakeNamedMaterial \"" + name + "\": \"string type\" is required");
+      throw SceneLoadError(d.where,
+                           "MakeNamedMaterial \"" + name + "\": \"string type\" is required");
     named_materials_[name] = {params.get_string("type", ""), std::move(params), d.where};
     return;
   }
@@ -334,19 +368,23 @@ void SceneConverter::handle(const Directive& d) {
     return;
   }
   if (n == "Texture") {
-    factory_.define_texture(d.args[0], d.args[1], d.args[2], with_attributes(d.params, "texture"), d.where, d.arg_where[0]);
+    factory_.define_texture(d.args[0], d.args[1], d.args[2], with_attributes(d.params, "texture"),
+                            d.where, d.arg_where[0]);
     return;
   }
   if (n == "LightSource") {
     if (current_object_) {
-      ctx_.warnings.warn(d.where, "lights inside ObjectBegin/ObjectEnd are not supported; ignored", "object light");
+      ctx_.warnings.warn(d.where, "lights inside ObjectBegin/ObjectEnd are not supported; ignored",
+                         "object light");
       return;
     }
-    add_light_source(d.args[0], with_attributes(d.params, "light"), d.where, state_.ctm, factory_, builder_, ctx_);
+    add_light_source(d.args[0], with_attributes(d.params, "light"), d.where, state_.ctm, factory_,
+                     builder_, ctx_);
     return;
   }
   if (n == "AreaLightSource") {
-    state_.area_light = make_area_light(d.args[0], with_attributes(d.params, "light"), d.where, ctx_);
+    state_.area_light =
+        make_area_light(d.args[0], with_attributes(d.params, "light"), d.where, ctx_);
     return;
   }
   if (n == "Shape") {
@@ -370,18 +408,25 @@ void SceneConverter::handle(const Directive& d) {
     r.where = d.where;
     if (state_.area_light) {
       if (current_object_)
-        ctx_.warnings.warn(d.where, "area lights inside ObjectBegin/ObjectEnd are not supported; the shape does not emit",
-                           "object area light");
+        ctx_.warnings.warn(
+            d.where,
+            "area lights inside ObjectBegin/ObjectEnd are not supported; the shape does not emit",
+            "object area light");
       else
         r.emission = state_.area_light;
     }
-    if (current_object_) objects_[*current_object_].push_back(std::move(r));
-    else add_shape_record(std::move(r));
+    if (current_object_)
+      objects_[*current_object_].push_back(std::move(r));
+    else
+      add_shape_record(std::move(r));
     return;
   }
   if (n == "ObjectBegin") {
-    if (current_object_) throw SceneLoadError(d.where, "ObjectBegin inside the definition of object \"" + *current_object_ + "\"");
-    if (objects_.count(d.args[0])) throw SceneLoadError(d.arg_where[0], "object \"" + d.args[0] + "\" is defined twice");
+    if (current_object_)
+      throw SceneLoadError(
+          d.where, "ObjectBegin inside the definition of object \"" + *current_object_ + "\"");
+    if (objects_.count(d.args[0]))
+      throw SceneLoadError(d.arg_where[0], "object \"" + d.args[0] + "\" is defined twice");
     blocks_.push_back({'o', d.where, state_});
     current_object_ = d.args[0];
     objects_[d.args[0]];
@@ -389,17 +434,22 @@ void SceneConverter::handle(const Directive& d) {
   }
   if (n == "ObjectEnd") {
     if (!current_object_ || blocks_.empty() || blocks_.back().kind != 'o')
-      throw SceneLoadError(d.where, current_object_ ? "ObjectEnd does not match the innermost open block at " + blocks_.back().where.str()
-                                                    : "ObjectEnd without a matching ObjectBegin");
+      throw SceneLoadError(d.where, current_object_
+                                        ? "ObjectEnd does not match the innermost open block at " +
+                                              blocks_.back().where.str()
+                                        : "ObjectEnd without a matching ObjectBegin");
     state_ = blocks_.back().saved;
     blocks_.pop_back();
     current_object_.reset();
     return;
   }
   if (n == "ObjectInstance") {
-    if (current_object_) throw SceneLoadError(d.where, "ObjectInstance inside the definition of object \"" + *current_object_ + "\"");
+    if (current_object_)
+      throw SceneLoadError(
+          d.where, "ObjectInstance inside the definition of object \"" + *current_object_ + "\"");
     auto it = objects_.find(d.args[0]);
-    if (it == objects_.end()) throw SceneLoadError(d.arg_where[0], "ObjectInstance: no object named \"" + d.args[0] + "\"");
+    if (it == objects_.end())
+      throw SceneLoadError(d.arg_where[0], "ObjectInstance: no object named \"" + d.args[0] + "\"");
     // Flattened: each shape is copied into world space (world-from-instance times the
     // shape's transform inside the definition), as pbrt-v4 composes them.
     for (const ShapeRecord& s : it->second) {
@@ -410,7 +460,8 @@ void SceneConverter::handle(const Directive& d) {
     return;
   }
   if (n == "MakeNamedMedium" || n == "MediumInterface") {
-    ctx_.warnings.warn(d.where, "participating media are not supported; " + n + " is ignored", "media " + n);
+    ctx_.warnings.warn(d.where, "participating media are not supported; " + n + " is ignored",
+                       "media " + n);
     mark_all_used(d.params);
     return;
   }
@@ -421,7 +472,9 @@ void SceneConverter::add_shape_record(ShapeRecord record) {
   const ShapeGeometry& g = *record.geometry;
   triangle_count_ += g.mesh ? g.mesh->triangle_count() : 1;
   if (ctx_.max_triangles > 0 && triangle_count_ > ctx_.max_triangles)
-    throw SceneLoadError(record.where, "the scene has more than " + std::to_string(ctx_.max_triangles) + " triangles (the limit set for this load)");
+    throw SceneLoadError(record.where, "the scene has more than " +
+                                           std::to_string(ctx_.max_triangles) +
+                                           " triangles (the limit set for this load)");
   shapes_.push_back(std::move(record));
 }
 
@@ -429,14 +482,18 @@ MaterialPtr SceneConverter::named_material(const std::string& name, const Source
   auto done = named_created_.find(name);
   if (done != named_created_.end()) return done->second;
   auto it = named_materials_.find(name);
-  if (it == named_materials_.end()) throw SceneLoadError(where, "no material named \"" + name + "\"");
+  if (it == named_materials_.end())
+    throw SceneLoadError(where, "no material named \"" + name + "\"");
   for (const std::string& c : creating_)
-    if (c == name) throw SceneLoadError(where, "material \"" + name + "\" contains itself (through \"mix\")");
-  if (creating_.size() >= 64) throw SceneLoadError(where, "materials nested more than 64 deep (through \"mix\")");
+    if (c == name)
+      throw SceneLoadError(where, "material \"" + name + "\" contains itself (through \"mix\")");
+  if (creating_.size() >= 64)
+    throw SceneLoadError(where, "materials nested more than 64 deep (through \"mix\")");
   creating_.push_back(name);
   const MaterialDef& def = it->second;
-  MaterialPtr m = factory_.make_material(def.type, def.params, def.where,
-                                         [this](const std::string& n, const SourceLocation& w) { return named_material(n, w); });
+  MaterialPtr m = factory_.make_material(
+      def.type, def.params, def.where,
+      [this](const std::string& n, const SourceLocation& w) { return named_material(n, w); });
   creating_.pop_back();
   named_created_[name] = m;
   return m;
@@ -447,8 +504,9 @@ MaterialPtr SceneConverter::material(const MaterialRef& ref) {
   std::optional<MaterialPtr>& slot = anonymous_created_[ref.index];
   if (!slot) {
     const MaterialDef& def = anonymous_materials_[ref.index];
-    slot = factory_.make_material(def.type, def.params, def.where,
-                                  [this](const std::string& n, const SourceLocation& w) { return named_material(n, w); });
+    slot = factory_.make_material(
+        def.type, def.params, def.where,
+        [this](const std::string& n, const SourceLocation& w) { return named_material(n, w); });
   }
   return *slot;
 }
@@ -473,7 +531,8 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
       // pbrt-v4 flips a quadric's normal when its transform swaps handedness.
       sphere.reverse_orientation = r.reverse_orientation != swaps;
       if (!is_finite(sphere.center) || !std::isfinite(sphere.radius)) {
-        ctx_.warnings.warn(r.where, "shape with non-finite coordinates skipped", "non-finite shape");
+        ctx_.warnings.warn(r.where, "shape with non-finite coordinates skipped",
+                           "non-finite shape");
         return;
       }
       AreaEmission e;
@@ -481,12 +540,14 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
         e.radiance = r.emission->radiance;
         e.two_sided = r.emission->two_sided;
         if (r.emission->power > 0)
-          e.radiance = e.radiance * (r.emission->power / ((e.two_sided ? 2 : 1) * 4 * kPi * sqr(sphere.radius) * kPi));
+          e.radiance = e.radiance * (r.emission->power /
+                                     ((e.two_sided ? 2 : 1) * 4 * kPi * sqr(sphere.radius) * kPi));
       }
       builder_.add_sphere(sphere, m, r.emission ? &e : nullptr);
       return;
     }
-    ctx_.warnings.warn(r.where, "sphere under a non-uniform scale or shear is tessellated into triangles",
+    ctx_.warnings.warn(r.where,
+                       "sphere under a non-uniform scale or shear is tessellated into triangles",
                        "tessellated sphere");
     mesh = tessellate_sphere(*g.sphere_radius, -*g.sphere_radius, *g.sphere_radius, 360);
     quadric = true;
@@ -524,7 +585,8 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
     tri.reverse_orientation = mesh->reverse_orientation;
     const float area = tri.area(0);
     AreaEmission ei = e;
-    ei.radiance = area > 0 ? e.radiance * (r.emission->power / ((e.two_sided ? 2 : 1) * area * kPi)) : Rgb(0.f);
+    ei.radiance = area > 0 ? e.radiance * (r.emission->power / ((e.two_sided ? 2 : 1) * area * kPi))
+                           : Rgb(0.f);
     builder_.add_mesh(std::move(tri), m, &ei);
   }
 }
@@ -532,9 +594,14 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
 void SceneConverter::finish() {
   if (!blocks_.empty()) {
     const Block& b = blocks_.back();
-    const char* open = b.kind == 'a' ? "AttributeBegin" : b.kind == 't' ? "TransformBegin" : "ObjectBegin";
-    const char* close = b.kind == 'a' ? "AttributeEnd" : b.kind == 't' ? "TransformEnd" : "ObjectEnd";
-    throw SceneLoadError(b.where, std::string(open) + " has no matching " + close + " before the end of the file");
+    const char* open = b.kind == 'a'   ? "AttributeBegin"
+                       : b.kind == 't' ? "TransformBegin"
+                                       : "ObjectBegin";
+    const char* close = b.kind == 'a'   ? "AttributeEnd"
+                        : b.kind == 't' ? "TransformEnd"
+                                        : "ObjectEnd";
+    throw SceneLoadError(
+        b.where, std::string(open) + " has no matching " + close + " before the end of the file");
   }
   // Every named material is created (as pbrt-v4 does), so mistakes in unused ones show.
   for (const auto& [name, def] : named_materials_) named_material(name, def.where);

@@ -33,8 +33,8 @@ class SceneConverter final : public DirectiveHandler {
 
  private:
   struct MaterialRef {
-    int index = 0;       // into anonymous_materials_, when name is empty
-    std::string name;    // a NamedMaterial
+    int index = 0;     // into anonymous_materials_, when name is empty
+    std::string name;  // a NamedMaterial
     SourceLocation where;
   };
   struct MaterialDef {

@@ -11,7 +11,8 @@ namespace {
 
 // Vertex attributes shared by trianglemesh and bilinearmesh: P (required), N and uv
 // (optional, one per vertex).
-void read_vertices(const ParamList& params, const std::string& shape, const SourceLocation& where, TriangleMesh* mesh) {
+void read_vertices(const ParamList& params, const std::string& shape, const SourceLocation& where,
+                   TriangleMesh* mesh) {
   const Param* p = params.find("P", {ParamType::Point3});
   if (!p) throw SceneLoadError(where, shape + ": \"point3 P\" (the vertex positions) is required");
   mesh->positions = params.get_point3s("P");
@@ -19,14 +20,15 @@ void read_vertices(const ParamList& params, const std::string& shape, const Sour
   if (const Param* np = params.find("N", {ParamType::Normal3})) {
     mesh->normals = params.get_normals("N");
     if (mesh->normals.size() != n)
-      param_error(*np, "expected one normal per vertex (" + std::to_string(n) + "), got " + std::to_string(mesh->normals.size()));
+      param_error(*np, "expected one normal per vertex (" + std::to_string(n) + "), got " +
+                           std::to_string(mesh->normals.size()));
   }
   if (const Param* up = params.find("uv", {ParamType::Point2, ParamType::Float})) {
     for (size_t i = 0; i + 1 < up->numbers.size(); i += 2)
       mesh->uvs.emplace_back(float(up->numbers[i]), float(up->numbers[i + 1]));
     if (up->numbers.size() % 2 != 0 || mesh->uvs.size() != n)
-      param_error(*up, "expected one uv pair per vertex (" + std::to_string(n) + "), got " + std::to_string(up->numbers.size()) +
-                           " numbers");
+      param_error(*up, "expected one uv pair per vertex (" + std::to_string(n) + "), got " +
+                           std::to_string(up->numbers.size()) + " numbers");
   }
   // Tangents and per-face indices (ptex) do not change the geometry.
   params.find("S");
@@ -36,8 +38,8 @@ void read_vertices(const ParamList& params, const std::string& shape, const Sour
 void check_indices(const Param* ip, const std::vector<int>& indices, size_t vertex_count) {
   for (int i : indices)
     if (i < 0 || size_t(i) >= vertex_count)
-      param_error(*ip, "vertex index " + std::to_string(i) + " is out of range (" + std::to_string(vertex_count) +
-                           " vertices in \"point3 P\")");
+      param_error(*ip, "vertex index " + std::to_string(i) + " is out of range (" +
+                           std::to_string(vertex_count) + " vertices in \"point3 P\")");
 }
 
 TriangleMesh make_triangle_mesh(const ParamList& params, const SourceLocation& where) {
@@ -47,11 +49,14 @@ TriangleMesh make_triangle_mesh(const ParamList& params, const SourceLocation& w
   std::vector<int> indices = params.get_ints("indices");
   if (!ip) {
     if (mesh.positions.size() != 3)
-      throw SceneLoadError(where, "trianglemesh: \"integer indices\" is required unless there are exactly 3 vertices");
+      throw SceneLoadError(
+          where,
+          "trianglemesh: \"integer indices\" is required unless there are exactly 3 vertices");
     indices = {0, 1, 2};
   } else {
     if (indices.size() % 3 != 0)
-      param_error(*ip, "expected a multiple of 3 indices (3 per triangle), got " + std::to_string(indices.size()));
+      param_error(*ip, "expected a multiple of 3 indices (3 per triangle), got " +
+                           std::to_string(indices.size()));
     check_indices(ip, indices, mesh.positions.size());
   }
   mesh.indices.assign(indices.begin(), indices.end());
@@ -65,17 +70,21 @@ TriangleMesh make_bilinear_mesh(const ParamList& params, const SourceLocation& w
   std::vector<int> indices = params.get_ints("indices");
   if (!ip) {
     if (mesh.positions.size() != 4)
-      throw SceneLoadError(where, "bilinearmesh: \"integer indices\" is required unless there are exactly 4 vertices");
+      throw SceneLoadError(
+          where,
+          "bilinearmesh: \"integer indices\" is required unless there are exactly 4 vertices");
     indices = {0, 1, 2, 3};
   } else {
     if (indices.size() % 4 != 0)
-      param_error(*ip, "expected a multiple of 4 indices (4 per patch), got " + std::to_string(indices.size()));
+      param_error(*ip, "expected a multiple of 4 indices (4 per patch), got " +
+                           std::to_string(indices.size()));
     check_indices(ip, indices, mesh.positions.size());
   }
   // A patch lists p00 p10 p01 p11; its boundary runs p00 p10 p11 p01, and pbrt-v4's normal
   // is cross(p10 - p00, p01 - p00), which both triangles keep.
   for (size_t i = 0; i < indices.size(); i += 4) {
-    const uint32_t p00 = indices[i], p10 = indices[i + 1], p01 = indices[i + 2], p11 = indices[i + 3];
+    const uint32_t p00 = indices[i], p10 = indices[i + 1], p01 = indices[i + 2],
+                   p11 = indices[i + 3];
     mesh.indices.insert(mesh.indices.end(), {p00, p10, p11, p00, p11, p01});
   }
   return mesh;
@@ -129,7 +138,8 @@ TriangleMesh make_ply(const ParamList& params, const SourceLocation& where, Load
     param_error(*fp, e.what());
   }
   if (ply.skipped_faces > 0)
-    ctx.warnings.warn(fp->where, "plymesh \"" + name + "\": skipped " + std::to_string(ply.skipped_faces) +
+    ctx.warnings.warn(fp->where, "plymesh \"" + name + "\": skipped " +
+                                     std::to_string(ply.skipped_faces) +
                                      " faces that are neither triangles nor quads");
   TriangleMesh mesh;
   mesh.positions = std::move(ply.positions);
@@ -142,8 +152,10 @@ TriangleMesh make_ply(const ParamList& params, const SourceLocation& where, Load
 }  // namespace
 
 TriangleMesh tessellate_sphere(float radius, float z_min, float z_max, float phi_max_degrees) {
-  const float zlo = clamp(std::min(z_min, z_max), -radius, radius), zhi = clamp(std::max(z_min, z_max), -radius, radius);
-  const float theta_lo = std::acos(clamp(zlo / radius, -1.f, 1.f)), theta_hi = std::acos(clamp(zhi / radius, -1.f, 1.f));
+  const float zlo = clamp(std::min(z_min, z_max), -radius, radius),
+              zhi = clamp(std::max(z_min, z_max), -radius, radius);
+  const float theta_lo = std::acos(clamp(zlo / radius, -1.f, 1.f)),
+              theta_hi = std::acos(clamp(zhi / radius, -1.f, 1.f));
   const float phi_max = radians(clamp(phi_max_degrees, 0.f, 360.f));
   const int nu = std::max(4, int(std::ceil(96 * phi_max / (2 * kPi)))), nv = 48;
   TriangleMesh mesh;
@@ -153,7 +165,8 @@ TriangleMesh tessellate_sphere(float radius, float z_min, float z_max, float phi
     for (int i = 0; i <= nu; ++i) {
       const float u = float(i) / float(nu);
       const float phi = u * phi_max;
-      const Vec3 n(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+      const Vec3 n(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                   std::cos(theta));
       mesh.positions.push_back(n * radius);
       mesh.normals.push_back(n);
       mesh.uvs.emplace_back(u, v);
@@ -161,7 +174,8 @@ TriangleMesh tessellate_sphere(float radius, float z_min, float z_max, float phi
   }
   const uint32_t row = uint32_t(nu + 1);
   auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
-    if (length_squared(cross(mesh.positions[b] - mesh.positions[a], mesh.positions[c] - mesh.positions[a])) > 0)
+    if (length_squared(cross(mesh.positions[b] - mesh.positions[a],
+                             mesh.positions[c] - mesh.positions[a])) > 0)
       mesh.indices.insert(mesh.indices.end(), {a, b, c});
   };
   for (int j = 0; j < nv; ++j)
@@ -174,14 +188,15 @@ TriangleMesh tessellate_sphere(float radius, float z_min, float z_max, float phi
   return mesh;
 }
 
-std::optional<ShapeGeometry> make_shape(const std::string& type, const ParamList& params, const SourceLocation& where,
-                                        LoaderContext& ctx) {
+std::optional<ShapeGeometry> make_shape(const std::string& type, const ParamList& params,
+                                        const SourceLocation& where, LoaderContext& ctx) {
   ShapeGeometry g;
   if (type == "trianglemesh") {
     g.mesh = make_triangle_mesh(params, where);
   } else if (type == "plymesh") {
     g.mesh = make_ply(params, where, ctx);
-    if (params.find("displacement")) ctx.warnings.warn(where, "plymesh: displacement is not supported; ignored");
+    if (params.find("displacement"))
+      ctx.warnings.warn(where, "plymesh: displacement is not supported; ignored");
     params.find("edgelength");
   } else if (type == "bilinearmesh") {
     g.mesh = make_bilinear_mesh(params, where);
@@ -195,27 +210,30 @@ std::optional<ShapeGeometry> make_shape(const std::string& type, const ParamList
   } else if (type == "sphere") {
     const float radius = params.get_float("radius", 1);
     if (!(radius > 0)) {
-      ctx.warnings.warn(where, "sphere with radius " + std::to_string(radius) + " is empty; skipped");
+      ctx.warnings.warn(where,
+                        "sphere with radius " + std::to_string(radius) + " is empty; skipped");
       return std::nullopt;
     }
     const float z_min = params.get_float("zmin", -radius), z_max = params.get_float("zmax", radius);
     const float phi_max = params.get_float("phimax", 360);
     if (z_min > -radius || z_max < radius || phi_max < 360) {
-      ctx.warnings.warn(where, "partial sphere (zmin, zmax or phimax) is tessellated into triangles",
+      ctx.warnings.warn(where,
+                        "partial sphere (zmin, zmax or phimax) is tessellated into triangles",
                         "partial sphere");
       g.mesh = tessellate_sphere(radius, z_min, z_max, phi_max);
       g.quadric = true;
     } else {
       g.sphere_radius = radius;
     }
-  } else if (type == "curve" || type == "cylinder" || type == "cone" || type == "paraboloid" || type == "hyperboloid" ||
-             type == "nurbs" || type == "heightfield") {
+  } else if (type == "curve" || type == "cylinder" || type == "cone" || type == "paraboloid" ||
+             type == "hyperboloid" || type == "nurbs" || type == "heightfield") {
     ctx.warnings.warn(where, "shape \"" + type + "\" is not supported; skipped", "shape " + type);
     for (const Param& p : params.all()) p.used = true;
     return std::nullopt;
   } else {
     throw SceneLoadError(where, "unknown shape \"" + type +
-                                    "\" (expected trianglemesh, plymesh, bilinearmesh, sphere, disk, cylinder, curve or loopsubdiv)");
+                                    "\" (expected trianglemesh, plymesh, bilinearmesh, sphere, "
+                                    "disk, cylinder, curve or loopsubdiv)");
   }
   return g;
 }

@@ -22,8 +22,8 @@ struct ShapeGeometry {
 };
 
 // Nothing if the shape is unsupported (warned). Throws SceneLoadError on malformed input.
-std::optional<ShapeGeometry> make_shape(const std::string& type, const ParamList& params, const SourceLocation& where,
-                                        LoaderContext& ctx);
+std::optional<ShapeGeometry> make_shape(const std::string& type, const ParamList& params,
+                                        const SourceLocation& where, LoaderContext& ctx);
 
 // Tessellated sphere cap/wedge in object space (pbrt-v4's parameterisation), with outward
 // shading normals and uv.

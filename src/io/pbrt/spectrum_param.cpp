@@ -10,7 +10,9 @@ namespace {
 
 std::vector<double> read_spectrum_file(const Param& p, const std::string& path) {
   std::ifstream in(path);
-  if (!in) param_error(p, "\"" + p.strings[0] + "\" is neither a built-in named spectrum nor a readable file");
+  if (!in)
+    param_error(
+        p, "\"" + p.strings[0] + "\" is neither a built-in named spectrum nor a readable file");
   std::vector<double> values;
   std::string line;
   while (std::getline(in, line)) {
@@ -22,12 +24,14 @@ std::vector<double> read_spectrum_file(const Param& p, const std::string& path) 
       double v = 0;
       const auto [ptr, ec] = std::from_chars(w.data(), w.data() + w.size(), v);
       if (ec != std::errc() || ptr != w.data() + w.size())
-        param_error(p, "\"" + path + "\": expected numbers (wavelength, value pairs), got \"" + w + "\"");
+        param_error(
+            p, "\"" + path + "\": expected numbers (wavelength, value pairs), got \"" + w + "\"");
       values.push_back(v);
     }
   }
   if (values.size() < 2 || values.size() % 2 != 0)
-    param_error(p, "\"" + path + "\": expected (wavelength, value) pairs, got " + std::to_string(values.size()) + " numbers");
+    param_error(p, "\"" + path + "\": expected (wavelength, value) pairs, got " +
+                       std::to_string(values.size()) + " numbers");
   return values;
 }
 
@@ -46,16 +50,19 @@ Rgb spectrum_param_rgb(const Param& p, SpectrumKind kind, LoaderContext& ctx) {
       // illuminant, so RGB emission comes out as written.
       return rgb;
     }
-    case ParamType::Blackbody: return blackbody_rgb(float(p.numbers[0]));
+    case ParamType::Blackbody:
+      return blackbody_rgb(float(p.numbers[0]));
     case ParamType::Spectrum: {
       if (p.strings.empty()) return sampled_spectrum_rgb(p.numbers, kind);
       if (std::optional<Rgb> named = named_spectrum(p.strings[0])) {
-        if (kind == SpectrumKind::Illuminant && named->luminance() > 0) return *named / named->luminance();
+        if (kind == SpectrumKind::Illuminant && named->luminance() > 0)
+          return *named / named->luminance();
         return *named;
       }
       return sampled_spectrum_rgb(read_spectrum_file(p, ctx.resolve(p.strings[0], p.where)), kind);
     }
-    default: param_error(p, "expected type rgb, spectrum or blackbody");
+    default:
+      param_error(p, "expected type rgb, spectrum or blackbody");
   }
 }
 

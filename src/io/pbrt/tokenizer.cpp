@@ -4,17 +4,23 @@ namespace caustica::pbrt {
 
 std::string describe(const Token& token) {
   switch (token.kind) {
-    case Token::Kind::End: return "end of file";
-    case Token::Kind::OpenBracket: return "\"[\"";
-    case Token::Kind::CloseBracket: return "\"]\"";
-    case Token::Kind::String: return "string \"" + token.text + "\"";
-    case Token::Kind::Word: break;
+    case Token::Kind::End:
+      return "end of file";
+    case Token::Kind::OpenBracket:
+      return "\"[\"";
+    case Token::Kind::CloseBracket:
+      return "\"]\"";
+    case Token::Kind::String:
+      return "string \"" + token.text + "\"";
+    case Token::Kind::Word:
+      break;
   }
   std::string text = token.text.size() > 40 ? token.text.substr(0, 40) + "..." : token.text;
   return "\"" + text + "\"";
 }
 
-Tokenizer::Tokenizer(std::string text, std::string file) : text_(std::move(text)), file_(std::move(file)) {}
+Tokenizer::Tokenizer(std::string text, std::string file)
+    : text_(std::move(text)), file_(std::move(file)) {}
 
 void Tokenizer::fail(int line, int column, const std::string& message) const {
   throw SceneLoadError({file_, line, column}, message);
@@ -37,7 +43,9 @@ Token Tokenizer::next() {
 }
 
 namespace {
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
+bool is_space(char c) {
+  return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
+}
 }  // namespace
 
 Token Tokenizer::scan() {
@@ -74,7 +82,8 @@ Token Tokenizer::scan() {
     advance();
     for (;;) {
       if (pos_ >= text_.size() || text_[pos_] == '\n')
-        fail(t.line, t.column, "unterminated string: missing closing '\"' before the end of the line");
+        fail(t.line, t.column,
+             "unterminated string: missing closing '\"' before the end of the line");
       const char s = text_[pos_];
       if (s == '"') {
         advance();
@@ -86,17 +95,34 @@ Token Tokenizer::scan() {
         if (pos_ >= text_.size()) fail(el, ec, "unterminated string: missing closing '\"'");
         const char e = text_[pos_];
         switch (e) {
-          case 'b': t.text += '\b'; break;
-          case 'f': t.text += '\f'; break;
-          case 'n': t.text += '\n'; break;
-          case 'r': t.text += '\r'; break;
-          case 't': t.text += '\t'; break;
-          case '\\': t.text += '\\'; break;
-          case '\'': t.text += '\''; break;
-          case '"': t.text += '"'; break;
+          case 'b':
+            t.text += '\b';
+            break;
+          case 'f':
+            t.text += '\f';
+            break;
+          case 'n':
+            t.text += '\n';
+            break;
+          case 'r':
+            t.text += '\r';
+            break;
+          case 't':
+            t.text += '\t';
+            break;
+          case '\\':
+            t.text += '\\';
+            break;
+          case '\'':
+            t.text += '\'';
+            break;
+          case '"':
+            t.text += '"';
+            break;
           default:
-            fail(el, ec, std::string("unknown escape sequence '\\") + (e == '\n' ? std::string("newline") : std::string(1, e)) +
-                             "' in string");
+            fail(el, ec,
+                 std::string("unknown escape sequence '\\") +
+                     (e == '\n' ? std::string("newline") : std::string(1, e)) + "' in string");
         }
         advance();
         continue;
@@ -108,8 +134,8 @@ Token Tokenizer::scan() {
   }
   t.kind = Token::Kind::Word;
   const size_t start = pos_;
-  while (pos_ < text_.size() && !is_space(text_[pos_]) && text_[pos_] != '"' && text_[pos_] != '[' &&
-         text_[pos_] != ']' && text_[pos_] != '#')
+  while (pos_ < text_.size() && !is_space(text_[pos_]) && text_[pos_] != '"' &&
+         text_[pos_] != '[' && text_[pos_] != ']' && text_[pos_] != '#')
     advance();
   t.text = text_.substr(start, pos_ - start);
   return t;

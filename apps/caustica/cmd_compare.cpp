@@ -8,11 +8,11 @@
 #include <sstream>
 
 #include "commands.h"
+#include "scene_setup.h"
 #include "experiment/comparison.h"
 #include "experiment/report.h"
 #include "image/image_io.h"
 #include "integrators/registry.h"
-#include "io/scene_loader.h"
 #include "render/output.h"
 #include "render/progress.h"
 #include "render/renderer.h"
@@ -22,14 +22,9 @@ namespace caustica::cli {
 
 namespace {
 
-struct CommonOptions {
-  std::string scene;
+struct CommonOptions : SceneSetup {
   double seconds = 0;
   int threads = 0;
-  int max_depth = -1;
-  uint64_t seed = 0;
-  std::string resolution;
-  std::string mis = "power";
 };
 
 void add_common(CLI::App* cmd, CommonOptions& o) {
@@ -38,35 +33,16 @@ void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_option("--max-depth", o.max_depth, "Maximum scattering vertices (default: the scene's, else 10)");
   cmd->add_option("--seed", o.seed, "Random seed");
   cmd->add_option("--resolution", o.resolution, "Override the film resolution, WxH");
-  cmd->add_option("--mis", o.mis, "MIS heuristic: power or balance");
+  cmd->add_option("--mis", o.mis, "MIS heuristic: balance or power (default: each integrator's)");
+  cmd->add_option("--camera", o.camera, "glTF: which camera to use (default: the first)");
 }
 
-// Loads the scene and fills settings; returns an exit code != 0 on bad input.
 int prepare(const CommonOptions& o, std::unique_ptr<Scene>* scene, IntegratorSettings* settings) {
-  if (!check_name("MIS heuristic", o.mis, {"balance", "power"})) return 2;
-  int w = 0, h = 0;
-  if (!o.resolution.empty() && (std::sscanf(o.resolution.c_str(), "%dx%d", &w, &h) != 2 || w <= 0 || h <= 0)) {
-    std::fprintf(stderr, "caustica: error: --resolution expects WxH, got '%s'\n", o.resolution.c_str());
-    return 2;
-  }
   if (o.seconds <= 0) {
     std::fprintf(stderr, "caustica: error: --time must be positive\n");
     return 2;
   }
-  try {
-    *scene = load_scene(o.scene);
-  } catch (const UnknownSceneError& e) {
-    std::fprintf(stderr, "caustica: error: %s\n", e.what());
-    return 2;
-  } catch (const SceneLoadError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 2;
-  }
-  if (w > 0) (*scene)->override_resolution(w, h);
-  settings->max_depth = o.max_depth >= 0 ? o.max_depth : ((*scene)->settings().max_depth > 0 ? (*scene)->settings().max_depth : 10);
-  settings->seed = o.seed;
-  settings->mis = o.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
-  return 0;
+  return load_configured_scene(o, scene, settings);
 }
 
 std::vector<std::string> split_list(const std::string& s) {

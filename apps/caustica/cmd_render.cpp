@@ -9,6 +9,7 @@
 #include <string>
 
 #include "commands.h"
+#include "scene_setup.h"
 #include "integrators/registry.h"
 #include "io/builtin_scenes.h"
 #include "io/scene_loader.h"
@@ -67,28 +68,17 @@ int run_render(const RenderOptions& o) {
     return 2;
   }
   if (!o.integrator.empty() && !check_name("integrator", o.integrator, integrator_names())) return 2;
-  if (!o.mis.empty() && !check_name("MIS heuristic", o.mis, {"balance", "power"})) return 2;
-  int res_w = 0, res_h = 0;
-  if (!o.resolution.empty() && (std::sscanf(o.resolution.c_str(), "%dx%d", &res_w, &res_h) != 2 || res_w <= 0 || res_h <= 0)) {
-    std::fprintf(stderr, "caustica render: error: --resolution expects WxH, e.g. 256x256, got '%s'\n", o.resolution.c_str());
-    return 2;
-  }
-
+  SceneSetup setup;
+  setup.scene = scene_name;
+  setup.camera = o.camera;
+  setup.resolution = o.resolution;
+  setup.max_depth = o.max_depth;
+  setup.seed = o.seed;
+  setup.mis = o.mis;
   std::unique_ptr<Scene> scene;
-  const auto load_start = std::chrono::steady_clock::now();
-  try {
-    LoadOptions load;
-    load.camera_index = o.camera;
-    scene = load_scene(scene_name, load);
-  } catch (const UnknownSceneError& e) {
-    std::fprintf(stderr, "caustica render: error: %s\n", e.what());
-    return 2;
-  } catch (const SceneLoadError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 2;
-  }
-  const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
-  if (res_w > 0) scene->override_resolution(res_w, res_h);
+  IntegratorSettings settings;
+  double load_seconds = 0;
+  if (int rc = load_configured_scene(setup, &scene, &settings, &load_seconds)) return rc;
 
   std::string integrator_name = o.integrator;
   if (integrator_name.empty()) {
@@ -97,11 +87,6 @@ int run_render(const RenderOptions& o) {
     for (const auto& n : integrator_names())
       if (n == from_scene) integrator_name = n;
   }
-  IntegratorSettings settings;
-  settings.max_depth = o.max_depth >= 0 ? o.max_depth : (scene->settings().max_depth > 0 ? scene->settings().max_depth : 10);
-  settings.seed = o.seed;
-  settings.mis = o.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
-  settings.mis_from_user = !o.mis.empty();
   settings.light_paths = o.light_paths;
   settings.radius = o.radius;
   settings.radius_alpha = o.radius_alpha;

@@ -1,0 +1,108 @@
+// The command line as a user meets it: outputs, statistics, exit codes and error messages.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "image/image_io.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+  int exit_code;
+  std::string err;
+};
+
+CliRun run(const std::string& args, const fs::path& dir) {
+  const fs::path err = dir / "stderr.txt";
+  const std::string cmd = "cd '" + dir.string() + "' && " + CAUSTICA_BINARY + " " + args + " > /dev/null 2> '" + err.string() + "'";
+  const int status = std::system(cmd.c_str());
+  std::ifstream f(err);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::path(testing::TempDir()) / ("caustica_cli_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+bool only_stderr_file(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename() != "stderr.txt") return false;
+  return true;
+}
+
+}  // namespace
+
+TEST(Cli, RenderWritesExrPngAndJsonStatistics) {
+  const fs::path d = fresh_dir("render");
+  const CliRun r = run("render cornell --spp 2 --resolution 24x16 --seed 3 --outfile out", d);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const caustica::Image exr = caustica::read_image((d / "out.exr").string());
+  EXPECT_EQ(exr.width(), 24);
+  EXPECT_EQ(exr.height(), 16);
+  EXPECT_TRUE(fs::exists(d / "out.png"));
+  std::ifstream f(d / "out.json");
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["integrator"], "pt");
+  EXPECT_EQ(j["spp"], 2);
+  EXPECT_EQ(j["resolution"], nlohmann::json({24, 16}));
+  EXPECT_EQ(j["seed"], 3);
+  EXPECT_GT(j["rays"].get<uint64_t>(), 24u * 16u * 2u);
+  EXPECT_GT(j["rays_per_second"].get<double>(), 0.0);
+  EXPECT_EQ(j["nonfinite_samples_discarded"], 0);
+  for (const char* key : {"seconds", "iterations", "threads", "max_depth", "scene"}) EXPECT_TRUE(j.contains(key)) << key;
+}
+
+TEST(Cli, UnknownNamesListTheValidOnesAndExitWith2) {
+  const fs::path d = fresh_dir("names");
+  CliRun r = run("render no-such-scene --spp 1", d);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("cornell-glass"), std::string::npos) << r.err;
+  r = run("render cornell --integrator nope --spp 1", d);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("vcm"), std::string::npos) << r.err;
+  r = run("render cornell --no-such-flag", d);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(only_stderr_file(d)) << "no output for bad input";
+}
+
+TEST(Cli, MalformedSceneFileGivesOneLocatedErrorAndNoImage) {
+  const fs::path d = fresh_dir("malformed");
+  std::ofstream(d / "bad.pbrt") << "LookAt 0 0 0  0 1 0  0 0 1\nCamera \"perspective\" \"float fov\" [ 45 ]\n"
+                                   "WorldBegin\nShape \"sphere\" \"float radius\" [ oops ]\n";
+  const CliRun r = run("render bad.pbrt --spp 1 --outfile out", d);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("bad.pbrt:4:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("error"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "out.exr"));
+  EXPECT_FALSE(fs::exists(d / "out.png"));
+  fs::remove(d / "bad.pbrt");
+  EXPECT_TRUE(only_stderr_file(d));
+}
+
+TEST(Cli, MissingFileIsAnErrorNamingIt) {
+  const fs::path d = fresh_dir("missing");
+  const CliRun r = run("render nothere.pbrt --spp 1", d);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("nothere.pbrt"), std::string::npos) << r.err;
+  EXPECT_TRUE(only_stderr_file(d));
+}
+
+TEST(Cli, HelpExistsForEverySubcommand) {
+  const fs::path d = fresh_dir("help");
+  for (const char* sub : {"render", "compare", "reference", "scenes"}) {
+    const CliRun r = run(std::string(sub) + " --help", d);
+    EXPECT_EQ(r.exit_code, 0) << sub;
+  }
+}

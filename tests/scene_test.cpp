@@ -85,3 +85,28 @@ TEST(Scene, EmissiveTrianglesBecomeAreaLights) {
   // Its back (top) side does not emit.
   EXPECT_TRUE(si.area_light->radiance(si.p, si.ng, si.uv, -si.wo).is_black());
 }
+
+TEST(Scene, ShadowRaysFromAPlaneThroughTheOriginDoNotHitIt) {
+  // Regression: a floor at y = 0 has a zero error bound along its normal; spawned rays must
+  // still leave it (material-spheres rendered a black floor before the fix).
+  SceneBuilder b;
+  TriangleMesh floor;
+  floor.positions = {{-5, 0, -5}, {5, 0, -5}, {5, 0, 5}, {-5, 0, 5}};
+  floor.indices = {0, 2, 1, 0, 3, 2};
+  b.add_mesh(floor, make_diffuse(make_constant_texture(Rgb(0.5f))));
+  CameraParams c;
+  b.set_camera(c);
+  auto scene = b.build("floor");
+  Pcg32 r(8, 8);
+  int blocked = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3 o(r.next_float() * 4 - 2, 1, r.next_float() * 4 - 2);
+    SurfaceInteraction si;
+    ASSERT_TRUE(scene->intersect({o, {0, -1, 0}, kInfinity}, &si));
+    ASSERT_EQ(si.p.y, 0.f);
+    const Vec3 light(r.next_float() * 2 - 1, 2, r.next_float() * 2 - 1);
+    blocked += scene->occluded(si.spawn_ray_to(light));
+    blocked += scene->occluded(si.spawn_ray(normalize(Vec3(0.3f, 1, 0.2f))));
+  }
+  EXPECT_EQ(blocked, 0);
+}

@@ -27,7 +27,11 @@ struct SurfaceInteraction {
 
   // Ray origin nudged off the surface along ng, to the side of w (pbrt-v4's OffsetRayOrigin).
   Vec3 offset_origin(Vec3 w) const {
-    const float d = dot(abs(ng), p_error);
+    // The error bound is exactly 0 for a point on an axis-aligned plane through 0 (all
+    // coordinates along the normal are 0): the origin would stay on the plane and Embree,
+    // which accepts t >= tnear = 0, would report the surface itself. A tiny absolute floor puts
+    // the origin strictly on the side of w in that case and is negligible otherwise.
+    const float d = dot(abs(ng), p_error) + 1e-9f;
     Vec3 offset = ng * d;
     if (dot(w, ng) < 0) offset = -offset;
     Vec3 po = p + offset;

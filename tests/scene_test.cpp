@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
+#include <tbb/info.h>
 
 #include "core/rng.h"
 #include "core/warp.h"
@@ -109,4 +111,12 @@ TEST(Scene, ShadowRaysFromAPlaneThroughTheOriginDoNotHitIt) {
     blocked += scene->occluded(si.spawn_ray(normalize(Vec3(0.3f, 1, 0.2f))));
   }
   EXPECT_EQ(blocked, 0);
+}
+
+TEST(Scene, BuildingASceneDoesNotCapTheRenderersParallelism) {
+  // Regression: creating the Embree device with "threads=1" installed a process-wide
+  // tbb::global_control, and every render ran on one thread.
+  auto scene = make_builtin_scene("cornell-glass", 8, 8);
+  EXPECT_EQ(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
+            size_t(tbb::info::default_concurrency()));
 }

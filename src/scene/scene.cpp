@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -120,7 +121,9 @@ Scene::Scene(SceneData data)
       settings_(std::move(data.settings)),
       name_(std::move(data.name)) {
   Impl& im = *impl_;
-  im.device = rtcNewDevice("threads=1,user_threads=0");
+  // No "threads=N" here: Embree's TBB backend implements it with a process-wide
+  // tbb::global_control, which would cap the renderer's own parallelism too.
+  im.device = rtcNewDevice(nullptr);
   if (!im.device) throw std::runtime_error("could not create the Embree device");
   rtcSetDeviceErrorFunction(im.device, embree_error, &im.error);
   im.scene = rtcNewScene(im.device);
@@ -165,7 +168,10 @@ Scene::Scene(SceneData data)
       bounds_.extend(s.sphere.center + Vec3(s.sphere.radius, s.sphere.radius, s.sphere.radius));
     }
   }
-  rtcCommitScene(im.scene);
+  // Build the BVH on one thread: its layout, and so the choice between equally close hits
+  // (shared edges), is then the same for any thread count, keeping images bit-identical.
+  tbb::task_arena single_threaded(1);
+  single_threaded.execute([&] { rtcCommitScene(im.scene); });
   // Dense primitive indices in geometry-id order (ids are assigned consecutively from 0).
   im.first_primitive.assign(im.mesh_of_geom.size(), 0);
   for (size_t g = 0, next = 0; g < im.mesh_of_geom.size(); ++g) {

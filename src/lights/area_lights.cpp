@@ -44,6 +44,25 @@ float area_to_solid_angle(float inv_area, float dist2, float cos_light) {
   return cos_light > 0 ? inv_area * dist2 / cos_light : 0.f;
 }
 
+// The NEE record of a diffuse emitter: radiance L leaving p (oriented normal n) toward the
+// reference point along -wi, with its solid-angle density and the emission densities the
+// bidirectional core needs for MIS.
+std::optional<LightLiSample> diffuse_li_sample(Rgb L, Vec3 p, Vec3 n, Vec3 wi, float dist, float pdf_w,
+                                               float inv_area, bool two_sided) {
+  if (!(pdf_w > 0) || !std::isfinite(pdf_w)) return std::nullopt;
+  LightLiSample s;
+  s.radiance = L;
+  s.wi = wi;
+  s.distance = dist;
+  s.p_light = p;
+  s.n_light = n;
+  s.pdf_w = pdf_w;
+  s.pdf_emit_pos = inv_area;
+  s.pdf_emit_dir = diffuse_emission_pdf(n, two_sided, -wi);
+  s.cos_at_light = abs_dot(n, wi);
+  return s;
+}
+
 class TriangleAreaLight final : public Light {
  public:
   TriangleAreaLight(const TriangleMesh& mesh, size_t tri, Rgb radiance, bool two_sided)
@@ -69,19 +88,8 @@ class TriangleAreaLight final : public Light {
     const Vec3 wi = d / dist;
     if (!emits_toward(-wi)) return std::nullopt;
     const float cos_light = abs_dot(n_, wi);
-    const float pdf = area_to_solid_angle(inv_area_, dist2, cos_light);
-    if (!(pdf > 0) || !std::isfinite(pdf)) return std::nullopt;
-    LightLiSample s;
-    s.radiance = L_;
-    s.wi = wi;
-    s.distance = dist;
-    s.p_light = p;
-    s.n_light = n_;
-    s.pdf_w = pdf;
-    s.pdf_emit_pos = inv_area_;
-    s.pdf_emit_dir = diffuse_emission_pdf(n_, two_sided_, -wi);
-    s.cos_at_light = cos_light;
-    return s;
+    return diffuse_li_sample(L_, p, n_, wi, dist, area_to_solid_angle(inv_area_, dist2, cos_light), inv_area_,
+                             two_sided_);
   }
 
   float pdf_li(Vec3 ref, Vec3 wi, Vec3 p_light, Vec3 n_light) const override {
@@ -179,18 +187,7 @@ class SphereAreaLight final : public Light {
     if (!emits_toward(n, -wi)) return std::nullopt;
     const float cos_light = abs_dot(n, wi);
     if (pdf < 0) pdf = area_to_solid_angle(inv_area_, dist2, cos_light);
-    if (!(pdf > 0) || !std::isfinite(pdf)) return std::nullopt;
-    LightLiSample s;
-    s.radiance = L_;
-    s.wi = wi;
-    s.distance = dist;
-    s.p_light = p;
-    s.n_light = n;
-    s.pdf_w = pdf;
-    s.pdf_emit_pos = inv_area_;
-    s.pdf_emit_dir = diffuse_emission_pdf(n, two_sided_, -wi);
-    s.cos_at_light = cos_light;
-    return s;
+    return diffuse_li_sample(L_, p, n, wi, dist, pdf, inv_area_, two_sided_);
   }
 
   // p_light must be where the ray (ref, wi) first hits the sphere.

@@ -8,6 +8,7 @@ namespace caustica {
 
 Camera::Camera(const CameraParams& p)
     : camera_to_world_(p.camera_to_world),
+      world_to_camera_(p.camera_to_world.inverse()),
       width_(p.width),
       height_(p.height),
       lens_radius_(p.lens_radius),
@@ -48,13 +49,11 @@ Ray Camera::generate_ray(Vec2 raster, Vec2 u_lens) const {
 }
 
 std::optional<Vec2> Camera::raster_of(Vec3 p_lens, Vec3 dir) const {
-  const Transform& to_cam = camera_to_world_;
-  Vec3 d = normalize(to_cam.inverse().vector(dir));
+  Vec3 d = normalize(world_to_camera_.vector(dir));
   if (d.z <= 0) return std::nullopt;
-  // Where the ray crosses the plane of focus, re-projected through the lens centre.
-  Vec3 o = to_cam.inverse().point(p_lens);
-  Vec3 focus = lens_radius_ > 0 ? o + d * (focal_distance_ / d.z) : o + d;
-  if (lens_radius_ > 0) d = focus;  // direction from the lens centre
+  // Thin lens: the film point is where the ray crosses the plane of focus, seen from the lens
+  // centre. A pinhole ray already starts at the centre.
+  if (lens_radius_ > 0) d = world_to_camera_.point(p_lens) + d * (focal_distance_ / d.z);
   const float sx = d.x / d.z / tan_half_fov_, sy = d.y / d.z / tan_half_fov_;
   const float rx = (sx - screen_min_x_) / (screen_max_x_ - screen_min_x_) * float(width_);
   const float ry = (screen_max_y_ - sy) / (screen_max_y_ - screen_min_y_) * float(height_);

@@ -63,7 +63,7 @@ class Camera {
   std::optional<CameraWiSample> sample_wi(Vec3 ref, Vec2 u_lens) const;
 
  private:
-  Transform camera_to_world_;
+  Transform camera_to_world_, world_to_camera_;
   int width_ = 0, height_ = 0;
   float lens_radius_ = 0, focal_distance_ = 1;
   float screen_min_x_ = -1, screen_max_x_ = 1, screen_min_y_ = -1, screen_max_y_ = 1;

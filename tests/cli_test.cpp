@@ -62,6 +62,8 @@ TEST(Cli, RenderWritesExrPngAndJsonStatistics) {
   EXPECT_GT(j["rays_per_second"].get<double>(), 0.0);
   EXPECT_EQ(j["nonfinite_samples_discarded"], 0);
   for (const char* key : {"seconds", "iterations", "threads", "max_depth", "scene"}) EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_GT(j["peak_memory_mb"].get<double>(), 1.0);
+  EXPECT_LT(j["peak_memory_mb"].get<double>(), 4096.0);
 }
 
 TEST(Cli, UnknownNamesListTheValidOnesAndExitWith2) {

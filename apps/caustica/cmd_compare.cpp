@@ -77,7 +77,8 @@ int run_reference(const ReferenceOptions& o) {
                          {"seconds", r.seconds},          {"iterations", r.iterations}, {"seed", o.seed},
                          {"threads", threads},            {"max_depth", settings.max_depth},
                          {"resolution", {scene->camera().width(), scene->camera().height()}},
-                         {"rays", r.rays},                {"nonfinite_samples_discarded", r.nonfinite}};
+                         {"rays", r.rays},                {"nonfinite_samples_discarded", r.nonfinite},
+                         {"peak_memory_mb", double(peak_memory_bytes()) / (1024 * 1024)}};
   integrator->report(meta);
   const OutputPaths paths = output_paths_for(out);
   write_render_outputs(r.image, meta, paths, 0.f);

@@ -116,6 +116,7 @@ int run_render(const RenderOptions& o) {
   stats["rays"] = result.rays;
   stats["rays_per_second"] = result.seconds > 0 ? double(result.rays) / result.seconds : 0.0;
   stats["nonfinite_samples_discarded"] = result.nonfinite;
+  stats["peak_memory_mb"] = double(peak_memory_bytes()) / (1024 * 1024);
   stats["threads"] = threads;
   stats["seed"] = o.seed;
   stats["max_depth"] = settings.max_depth;

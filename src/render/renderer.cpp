@@ -1,5 +1,7 @@
 #include "render/renderer.h"
 
+#include <sys/resource.h>
+
 #include <chrono>
 #include <stdexcept>
 
@@ -8,6 +10,12 @@
 #include "scene/scene.h"
 
 namespace caustica {
+
+uint64_t peak_memory_bytes() {
+  struct rusage usage {};
+  getrusage(RUSAGE_SELF, &usage);
+  return uint64_t(usage.ru_maxrss) * 1024;  // Linux reports kilobytes
+}
 
 RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudget& budget,
                     const RenderCallbacks& callbacks) {

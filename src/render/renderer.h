@@ -35,6 +35,9 @@ struct RenderCallbacks {
   std::function<bool(const Film&, uint32_t iterations, double seconds)> on_iteration;
 };
 
+// Peak resident memory of this process so far, in bytes (getrusage).
+uint64_t peak_memory_bytes();
+
 RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudget& budget,
                     const RenderCallbacks& callbacks = {});
 

@@ -40,12 +40,19 @@ class ScratchArena {
   void reset() { current_ = 0; used_ = 0; }
 
  private:
+  static constexpr std::align_val_t kAlignment{64};
+  // Memory from aligned operator new must go back through aligned operator delete.
+  struct AlignedDelete {
+    void operator()(std::byte* p) const { ::operator delete[](p, kAlignment); }
+  };
   struct Block {
-    std::unique_ptr<std::byte[]> data;
+    std::unique_ptr<std::byte[], AlignedDelete> data;
     size_t size;
   };
   void grow(size_t bytes) {
-    blocks_.push_back({std::unique_ptr<std::byte[]>(new (std::align_val_t(64)) std::byte[bytes]), bytes});
+    blocks_.push_back({std::unique_ptr<std::byte[], AlignedDelete>(
+                           static_cast<std::byte*>(::operator new[](bytes, kAlignment))),
+                       bytes});
     current_ = blocks_.size() - 1;
     used_ = 0;
   }

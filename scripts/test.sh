@@ -1,9 +1,18 @@
 #!/usr/bin/env bash
 # Quick start (b): install dependencies, build, run every test through CTest.
+#  1. the unit tests under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/), except
+#     the headless-browser test; set CAUSTICA_SANITIZERS=0 to skip this stage;
+#  2. the whole suite on the Release build (build/). Its CTest summary is the last output.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 # chromium: the HTML report is tested in a headless browser.
 "$root/scripts/install-deps.sh" chromium
+jobs="$(nproc)"
+if [[ "${CAUSTICA_SANITIZERS:-1}" != 0 ]]; then
+  cmake -S "$root" -B "$root/build-asan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCAUSTICA_SANITIZE=ON >/dev/null
+  cmake --build "$root/build-asan" --parallel "$jobs" --target caustica caustica_tests
+  (cd "$root/build-asan" && ctest --output-on-failure --parallel "$jobs" -E '^ReportBrowser')
+fi
 "$root/scripts/build.sh"
 cd "$root/build"
-ctest --output-on-failure --parallel "$(nproc)" "$@"
+ctest --output-on-failure --parallel "$jobs" "$@"

@@ -1,11 +1,11 @@
 #!/bin/sh
-# Seeds the fuzzing corpus with the shared scenes (../shared/scenes) and the regression
+# Seeds the fuzzing corpus with the shared scenes (scenes/ in the repository) and the regression
 # inputs in tests/data/pbrt_crashers. Usage: fuzz/make_corpus.sh [corpus-dir]
 set -e
 here=$(cd "$(dirname "$0")" && pwd)
 corpus=${1:-$here/../build-fuzz/corpus}
 mkdir -p "$corpus"
-for f in "$here"/../../shared/scenes/*.pbrt "$here"/../../shared/scenes/pbrt-v4/*/scene-v4.pbrt; do
+for f in "$here"/../scenes/*.pbrt "$here"/../scenes/pbrt-v4/*/scene-v4.pbrt; do
   name=$(echo "$f" | sed 's|.*/scenes/||; s|/|_|g')
   cp "$f" "$corpus/seed_$name"
 done

@@ -1,6 +1,6 @@
 // What the pbrt loader builds: camera handedness and projection as pbrt-v4 has them,
 // transforms, shapes and their orientation, area and other lights, textures, and every
-// scene in ../shared/scenes.
+// scene in scenes/ (copied from the project's shared scenes).
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -254,7 +254,7 @@ TEST(PbrtInstancing, ObjectInstancesAreFlattenedCopies) {
 // --- The shared scenes ---------------------------------------------------------------
 
 std::string shared(const std::string& rel) {
-  return std::string(CAUSTICA_SHARED_SCENES) + "/" + rel;
+  return std::string(CAUSTICA_SCENES) + "/" + rel;
 }
 
 TEST(PbrtSharedScenes, CornellCausticsLoadsAndProjectsLikePbrtV4) {

@@ -1,7 +1,8 @@
+#include "scene/camera.h"
+
 #include <gtest/gtest.h>
 
 #include "core/rng.h"
-#include "scene/camera.h"
 
 using namespace caustica;
 
@@ -62,7 +63,7 @@ TEST(Camera, ImportanceAndDirectionPdfAreConsistent) {
       const Vec2 raster((x + 0.5f) * 40 / n, (y + 0.5f) * 30 / n);
       const Ray ray = cam.generate_ray(raster, {0.5f, 0.5f});
       float pdf_pos, pdf_dir;
-      cam.pdf_we(ray.d, &pdf_pos, &pdf_dir);
+      cam.pdf_we(ray.o, ray.d, &pdf_pos, &pdf_dir);
       const float we = cam.importance(ray.o, ray.d);
       ASSERT_GT(pdf_dir, 0);
       // Uniform raster sampling has density pdf_dir over directions: the MC estimate of the
@@ -89,4 +90,26 @@ TEST(Camera, SampleWiAgreesWithImportanceAndPdf) {
     EXPECT_NEAR(distance(s->p_lens - s->wi * s->distance, ref), 0, 1e-4);
   }
   EXPECT_GT(hits, 90);
+}
+
+// A thin-lens ray leaving the lens off centre toward the film border is on the film: its
+// densities must not be zero (they used to be tested from the lens centre, which dropped about
+// 4 pixels of border at 64x64).
+TEST(Camera, ThinLensBorderRaysHaveTheirDensity) {
+  const Camera cam = test_camera(64, 64, 0.3f);
+  Pcg32 r(5, 5);
+  for (int i = 0; i < 2000; ++i) {
+    // Raster points within half a pixel of the border, any lens point.
+    const float t = r.next_float() * 64, e = r.next_float() * 0.5f;
+    const int side = int(r.next_bounded(4));
+    const Vec2 raster = side == 0   ? Vec2(e, t)
+                        : side == 1 ? Vec2(64 - e, t)
+                        : side == 2 ? Vec2(t, e)
+                                    : Vec2(t, 64 - e);
+    const Ray ray = cam.generate_ray(raster, r.next_2d());
+    float pdf_pos, pdf_dir;
+    cam.pdf_we(ray.o, ray.d, &pdf_pos, &pdf_dir);
+    ASSERT_GT(pdf_dir, 0) << "raster " << raster.x << ", " << raster.y;
+    ASSERT_GT(cam.importance(ray.o, ray.d), 0);
+  }
 }

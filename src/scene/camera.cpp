@@ -27,7 +27,8 @@ Camera::Camera(const CameraParams& p)
     screen_max_y_ = 1.f / aspect;
   }
   tan_half_fov_ = std::tan(radians(p.fov_degrees) * 0.5f);
-  image_plane_area_ = (screen_max_x_ - screen_min_x_) * (screen_max_y_ - screen_min_y_) * sqr(tan_half_fov_);
+  image_plane_area_ =
+      (screen_max_x_ - screen_min_x_) * (screen_max_y_ - screen_min_y_) * sqr(tan_half_fov_);
   origin_ = camera_to_world_.point({0, 0, 0});
   forward_ = normalize(camera_to_world_.vector({0, 0, 1}));
 }
@@ -67,9 +68,9 @@ float Camera::importance(Vec3 p_lens, Vec3 dir) const {
   return 1.f / (image_plane_area_ * lens_area() * sqr(sqr(cos_theta)));
 }
 
-void Camera::pdf_we(Vec3 dir, float* pdf_pos, float* pdf_dir) const {
+void Camera::pdf_we(Vec3 p_lens, Vec3 dir, float* pdf_pos, float* pdf_dir) const {
   const float cos_theta = dot(dir, forward_);
-  if (cos_theta <= 0 || !raster_of(origin_, dir)) {
+  if (cos_theta <= 0 || !raster_of(p_lens, dir)) {
     *pdf_pos = *pdf_dir = 0;
     return;
   }

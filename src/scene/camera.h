@@ -26,12 +26,12 @@ struct CameraParams {
 };
 
 struct CameraWiSample {
-  float importance = 0;   // We along the ray from the lens point to ref
-  Vec3 wi;                // unit, from ref toward the lens point
+  float importance = 0;  // We along the ray from the lens point to ref
+  Vec3 wi;               // unit, from ref toward the lens point
   float distance = 0;
-  Vec3 p_lens;            // the point on the lens (world)
-  float pdf_w = 0;        // solid-angle density at ref of choosing this lens point
-  Vec2 raster;            // where the ray lands on the film
+  Vec3 p_lens;              // the point on the lens (world)
+  float pdf_w = 0;          // solid-angle density at ref of choosing this lens point
+  Vec2 raster;              // where the ray lands on the film
   float cos_at_camera = 0;  // cos between the camera axis and the direction to ref
 };
 
@@ -59,7 +59,9 @@ class Camera {
   std::optional<Vec2> project(Vec3 p) const { return raster_of(origin_, normalize(p - origin_)); }
 
   float importance(Vec3 p_lens, Vec3 dir) const;  // We(p_lens, dir): 0 off the film
-  void pdf_we(Vec3 dir, float* pdf_pos, float* pdf_dir) const;
+  // Densities of a camera ray leaving the lens point p_lens along dir (pbrt-v4 PDF_We): the film
+  // test uses the point the ray left from, so thin-lens rays near the border are not lost.
+  void pdf_we(Vec3 p_lens, Vec3 dir, float* pdf_pos, float* pdf_dir) const;
   std::optional<CameraWiSample> sample_wi(Vec3 ref, Vec2 u_lens) const;
 
  private:

@@ -15,6 +15,7 @@
 #include "core/rng.h"
 #include "image/image_io.h"
 #include "integrators/bidir/hash_grid.h"
+#include "integrators/bidir/light_path_assignment.h"
 #include "integrators/bidir/light_vertex.h"
 #include "integrators/bidir/techniques.h"
 #include "lights/light.h"
@@ -33,7 +34,6 @@ using bidir::LightVertex;
 using bidir::LightVertexData;
 using bidir::MisRules;
 using bidir::MisSums;
-using bidir::PositionCodec;
 
 constexpr uint32_t kChunkPaths = 1024;  // light paths per chunk: fixed, independent of threads
 constexpr float kDefaultRadiusFactor = 0.003f;
@@ -161,7 +161,8 @@ struct Iteration {
   uint32_t index = 0;
   float radius = 0;
   MisRules rules{MisHeuristic::Balance, false, false, 1, 0};
-  float merge_normalization = 0;  // 1 / (N pi r^2)
+  float merge_normalization = 0;             // 1 / (N pi r^2)
+  bidir::LightPathAssignment light_path_of;  // pixel -> the light subpath it connects to
 };
 
 // A value added to the pixel and, if technique images are kept, to its technique.
@@ -204,7 +205,6 @@ class BidirIntegrator final : public Integrator {
     scene.bounds().bounding_sphere(&center, &scene_radius);
     base_radius_ = settings_.radius > 0 ? settings_.radius
                                         : kDefaultRadiusFactor * std::max(scene_radius, 1e-3f);
-    codec_ = PositionCodec(scene.bounds().lo, scene.bounds().hi);
     light_paths_ = settings_.light_paths > 0 ? settings_.light_paths : film.pixel_count();
     if (!settings_.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
     const uint64_t chunks = (light_paths_ + kChunkPaths - 1) / kChunkPaths;
@@ -222,9 +222,11 @@ class BidirIntegrator final : public Integrator {
     it.rules = MisRules(heuristic_, tech_.connect || tech_.light_to_camera, tech_.merge,
                         float(light_paths_), it.radius);
     it.merge_normalization = 1.f / (kPi * it.radius * it.radius * float(light_paths_));
+    it.light_path_of =
+        bidir::LightPathAssignment(film.pixel_count(), light_paths_, iteration, settings_.seed);
 
     trace_light_paths(scene, it, film);
-    if (tech_.merge) grid_.build(vertices_, codec_, it.radius);
+    if (tech_.merge) grid_.build(vertices_, it.radius);
     trace_camera_paths(scene, it, film);
 
     ++iterations_;
@@ -353,8 +355,8 @@ class BidirIntegrator final : public Integrator {
 
       if (!bsdf.is_delta()) {
         if (stores_vertices()) {
-          chunk.vertices.push_back(bidir::pack_light_vertex(
-              {si.p, si.wo, scene.primitive_index(si), depth, beta, mis}, codec_));
+          chunk.vertices.push_back(
+              bidir::pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}));
         }
         if (tech_.light_to_camera)
           connect_to_camera(scene, it, si, bsdf, beta, mis, depth, rng, chunk);
@@ -439,12 +441,11 @@ class BidirIntegrator final : public Integrator {
     const Vec2 jitter = rng.next_2d();
     const Vec2 lens = rng.next_2d();
     Ray ray = camera.generate_ray({x + jitter.x, y + jitter.y}, lens);
-    const float pdf_camera = bidir::camera_pdf_w(camera, ray.d);
+    const float pdf_camera = bidir::camera_pdf_w(camera, ray.o, ray.d);
     if (!(pdf_camera > 0)) return;
     MisSums mis = it.rules.camera_start(pdf_camera);
     const int max_depth = settings_.max_depth;
-    const uint64_t light_path =
-        pixel % light_paths_;  // the light subpath this camera path connects to
+    const uint64_t light_path = it.light_path_of.light_path(pixel);
 
     Rgb beta(1.f);
     Vec3 prev_p = ray.o;
@@ -556,7 +557,7 @@ class BidirIntegrator final : public Integrator {
       const LightVertex& stored = vertices_[i];
       // Stored in increasing depth: once too long, all the rest are too.
       if (bidir::light_vertex_depth(stored) + depth > settings_.max_depth) break;
-      const LightVertexData v = bidir::unpack_light_vertex(stored, codec_);
+      const LightVertexData v = bidir::unpack_light_vertex(stored);
       const SurfaceInteraction light_si = scene.interaction_at(v.primitive, v.p, v.wo);
       const Bsdf light_bsdf = light_si.material->bsdf(light_si, arena);
       if (!light_bsdf.valid()) continue;
@@ -581,12 +582,18 @@ class BidirIntegrator final : public Integrator {
   void merge(const Iteration& it, const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
              const MisSums& mis, int depth, PixelAccumulator& acc) const {
     const int max_depth = settings_.max_depth;
-    grid_.for_each_near(si.p, vertices_, codec_, [&](uint32_t index, Vec3) {
+    grid_.for_each_near(si.p, vertices_, [&](uint32_t index, Vec3) {
       const LightVertex& stored = vertices_[index];
       const int light_depth = bidir::light_vertex_depth(stored);
       if (light_depth + depth - 1 > max_depth) return;
-      const LightVertexData v = bidir::unpack_light_vertex(stored, codec_);
-      const Rgb f = bsdf.f(si.wo, v.wo, TransportMode::Radiance);
+      const LightVertexData v = bidir::unpack_light_vertex(stored);
+      // The photon's throughput carries the flux through the surface (geometric cosine); the
+      // camera vertex integrates with the shading cosine: |ns . wi| / |ng . wi|, as NEE and
+      // connections have it through abs_cos (Veach 1997, section 5.3).
+      const float cos_geometric = bidir::geometric_cos(si, v.wo);
+      if (!(cos_geometric > 0)) return;
+      const Rgb f =
+          bsdf.f(si.wo, v.wo, TransportMode::Radiance) * (bsdf.abs_cos(v.wo) / cos_geometric);
       if (f.is_black()) return;
       const float w =
           tech_.unweighted ? 1.f : bidir::weight_merge(it.rules, v.wo, v.mis, si, bsdf, mis);
@@ -601,7 +608,6 @@ class BidirIntegrator final : public Integrator {
   MisHeuristic heuristic_;
   float base_radius_ = 0, last_radius_ = 0;
   uint64_t light_paths_ = 0;
-  PositionCodec codec_;
 
   // Per-iteration buffers, reused.
   std::vector<LightChunk> chunks_;

@@ -1,9 +1,11 @@
 // Range search over the stored light vertices: a hashed uniform grid with cells of size 2r,
 // built by a counting sort in vertex order (deterministic, no per-cell allocation). A query
 // visits the 2x2x2 cells that a ball of radius r around the point can touch (Georgiev's
-// SmallVCM grid, Teschner et al. 2003 hash).
+// SmallVCM grid, Teschner et al. 2003 hash). Two of those cells can hash to one bucket; each
+// bucket is visited once, so no vertex is ever counted twice.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -15,24 +17,31 @@ namespace caustica::bidir {
 
 class HashGrid {
  public:
-  void build(const std::vector<LightVertex>& vertices, const PositionCodec& codec, float radius);
+  // table_size: buckets (rounded up to a power of two); 0 = about the vertex count.
+  void build(const std::vector<LightVertex>& vertices, float radius, uint32_t table_size = 0);
 
   // fn(vertex_index, light_position) for every vertex within the radius of p.
   template <typename Fn>
-  void for_each_near(Vec3 p, const std::vector<LightVertex>& vertices, const PositionCodec& codec,
-                     Fn&& fn) const {
+  void for_each_near(Vec3 p, const std::vector<LightVertex>& vertices, Fn&& fn) const {
     if (cell_start_.empty()) return;
-    const Vec3 g = (p - lo_) * inv_cell_;
-    const int cx = int(std::floor(g.x)), cy = int(std::floor(g.y)), cz = int(std::floor(g.z));
-    // The neighbour on the side of the cell that p is closer to, per axis.
-    const int nx = g.x - cx < 0.5f ? -1 : 1, ny = g.y - cy < 0.5f ? -1 : 1,
-              nz = g.z - cz < 0.5f ? -1 : 1;
+    int c[3], n[3];
+    for (int a = 0; a < 3; ++a) {
+      const double g = grid_coordinate(p, a);
+      c[a] = int(std::floor(g));
+      n[a] = g - c[a] < 0.5 ? -1 : 1;  // the neighbour on the side p is closer to
+    }
+    uint32_t buckets[8];
+    int count = 0;
     for (int k = 0; k < 8; ++k) {
-      const uint32_t cell =
-          hash(cx + ((k & 1) ? nx : 0), cy + ((k & 2) ? ny : 0), cz + ((k & 4) ? nz : 0));
+      const uint32_t b = hash(c[0] + ((k & 1) ? n[0] : 0), c[1] + ((k & 2) ? n[1] : 0),
+                              c[2] + ((k & 4) ? n[2] : 0));
+      if (std::find(buckets, buckets + count, b) == buckets + count) buckets[count++] = b;
+    }
+    for (int k = 0; k < count; ++k) {
+      const uint32_t cell = buckets[k];
       for (uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
         const uint32_t index = indices_[i];
-        const Vec3 q = codec.decode(vertices[index].position);
+        const Vec3 q = vertices[index].p();
         if (distance_squared(p, q) <= radius2_) fn(index, q);
       }
     }
@@ -43,13 +52,25 @@ class HashGrid {
   }
 
  private:
+  // Cell coordinate along axis a relative to the vertices' bounds, in double so that a point far
+  // from the bounds' corner (a huge scene, a tiny radius) still lands in the right cell, and
+  // clamped so that it never overflows the integer conversion (clamped cells only collide).
+  double grid_coordinate(Vec3 p, int a) const {
+    constexpr double kLimit = double(1 << 30);
+    return std::clamp((double(p[a]) - double(lo_[a])) * inv_cell_, -kLimit, kLimit);
+  }
+  uint32_t cell_of(Vec3 p) const {
+    return hash(int(std::floor(grid_coordinate(p, 0))), int(std::floor(grid_coordinate(p, 1))),
+                int(std::floor(grid_coordinate(p, 2))));
+  }
   uint32_t hash(int x, int y, int z) const {
     return ((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ (uint32_t(z) * 83492791u)) &
            (table_size_ - 1);
   }
 
   Vec3 lo_;
-  float inv_cell_ = 1, radius2_ = 0;
+  double inv_cell_ = 1;
+  float radius2_ = 0;
   uint32_t table_size_ = 0;
   std::vector<uint32_t> cell_start_;  // table_size_ + 1 offsets into indices_
   std::vector<uint32_t> indices_;     // vertex indices sorted by cell

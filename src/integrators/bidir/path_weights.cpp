@@ -20,7 +20,6 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   const float pmf = scene.light_sampler().pmf(&light);
   const bool finite = !light.is_infinite();
   const int k = int(path.surfaces.size()) + 1;  // segments
-  const PositionCodec codec(scene.bounds().lo, scene.bounds().hi);
 
   // Positions x0..xk; for infinite lights x0 is a point far back along the emission direction.
   std::vector<Vec3> x(k + 1);
@@ -65,14 +64,13 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   }
   auto stored = [&](int i) {
     return unpack_light_vertex(
-               pack_light_vertex({x[i], light_si[i].wo, 0, i, Rgb(1.f), light_mis[i]}, codec),
-               codec)
+               pack_light_vertex({x[i], light_si[i].wo, 0, i, Rgb(1.f), light_mis[i]}))
         .mis;
   };
 
   // Camera subpath replay: sums at x(k-1) down to x1, and at the emitter (s = 0).
   std::vector<MisSums> camera_mis(k);
-  camera_mis[k - 1] = rules.camera_start(camera_pdf_w(scene.camera(), dir(k, k - 1)));
+  camera_mis[k - 1] = rules.camera_start(camera_pdf_w(scene.camera(), x[k], dir(k, k - 1)));
   rules.hit(camera_mis[k - 1], distance_squared(x[k], x[k - 1]),
             geometric_cos(camera_si[k - 1], dir(k - 1, k)));
   for (int i = k - 2; i >= 1; --i) {

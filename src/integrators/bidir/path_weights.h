@@ -1,6 +1,6 @@
 // The MIS weights the renderer gives one explicit path under each technique that can make it,
 // computed by replaying both subpaths through the renderer's own update and weight code
-// (techniques.h, with light sums stored and reloaded through the 32-byte light vertex). It is
+// (techniques.h, with light sums stored and reloaded through the 40-byte light vertex). It is
 // the hook for the tests' brute-force MIS oracle; the renderer never calls it.
 #pragma once
 

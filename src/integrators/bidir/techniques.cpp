@@ -5,9 +5,9 @@
 
 namespace caustica::bidir {
 
-float camera_pdf_w(const Camera& camera, Vec3 dir) {
+float camera_pdf_w(const Camera& camera, Vec3 p_lens, Vec3 dir) {
   float pdf_pos, pdf_dir;
-  camera.pdf_we(dir, &pdf_pos, &pdf_dir);
+  camera.pdf_we(p_lens, dir, &pdf_pos, &pdf_dir);
   // pdf_we is normalised over the whole image; one camera sample per pixel sees pixel_count times
   // it.
   return float(camera.pixel_count()) * pdf_dir;
@@ -86,7 +86,7 @@ float weight_light_to_camera(const MisRules& rules, const Camera& camera,
   const Vec3 d = p_lens - si.p;
   const float dist2 = length_squared(d);
   const Vec3 dir = d / std::sqrt(dist2);
-  const float camera_pdf_a = camera_pdf_w(camera, -dir) * geometric_cos(si, dir) / dist2;
+  const float camera_pdf_a = camera_pdf_w(camera, p_lens, -dir) * geometric_cos(si, dir) / dist2;
   const float rev = bsdf.pdf(dir, wo, TransportMode::Radiance);
   return rules.light_to_camera(light, camera_pdf_a, rev);
 }

@@ -21,8 +21,9 @@ namespace caustica::bidir {
 // |cos| with the geometric normal: the measure conversions of the MIS pdfs (see mis.h).
 inline float geometric_cos(const SurfaceInteraction& si, Vec3 w) { return abs_dot(si.ng, w); }
 
-// Per-pixel solid-angle density of a camera ray leaving along dir (0 off the film).
-float camera_pdf_w(const Camera& camera, Vec3 dir);
+// Per-pixel solid-angle density of a camera ray leaving lens point p_lens along dir (0 off the
+// film).
+float camera_pdf_w(const Camera& camera, Vec3 p_lens, Vec3 dir);
 
 // MIS sums at the first light vertex y1, reached at distance dist from the emission sample.
 MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf,

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "core/rng.h"
+#include "image/image.h"
 #include "integrators/bidir/light_vertex.h"
 #include "integrators/bidir/path_weights.h"
 #include "integrators/bidir/techniques.h"
@@ -59,6 +60,46 @@ std::unique_ptr<Scene> mixed_lights_scene() {
   return b.build("mis-test");
 }
 
+// The corners the Cornell boxes miss: a distant light and an image environment (importance
+// sampled), a floor and a ball with interpolated shading normals that lean away from the
+// geometric ones, glass, and a thin-lens camera (lens points off the centre).
+std::unique_ptr<Scene> corners_scene() {
+  SceneBuilder b;
+  TriangleMesh floor;
+  floor.positions = {{-3, 0, -3}, {3, 0, -3}, {3, 0, 3}, {-3, 0, 3}};
+  floor.indices = {0, 2, 1, 0, 3, 2};
+  floor.normals = {normalize(Vec3(0.3f, 1, 0.1f)), normalize(Vec3(-0.2f, 1, 0.3f)),
+                   normalize(Vec3(0.1f, 1, -0.4f)), normalize(Vec3(-0.3f, 1, -0.2f))};
+  b.add_mesh(floor, make_diffuse(make_constant_texture(Rgb(0.7f, 0.6f, 0.5f))));
+  // A coarse octahedron ball with smooth (vertex) normals.
+  TriangleMesh ball;
+  const Vec3 c(0.6f, 0.5f, 0.4f);
+  const Vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const Vec3& a : axes) {
+    ball.positions.push_back(c + a * 0.45f);
+    ball.normals.push_back(a);
+  }
+  ball.indices = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
+  b.add_mesh(ball, make_diffuse(make_constant_texture(Rgb(0.5f, 0.7f, 0.6f))));
+  DielectricParams glass;
+  glass.eta = 1.5f;
+  b.add_sphere({{-0.7f, 0.5f, 0.2f}, 0.5f}, make_dielectric(glass));
+  b.add_light(make_distant_light(normalize(Vec3(0.3f, -1.f, 0.5f)), Rgb(2.f, 1.8f, 1.5f)));
+  auto sky = std::make_shared<Image>(16, 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x) sky->at(x, y) = Rgb(0.2f + 0.1f * x, 0.5f, 1.5f - 0.15f * y);
+  b.add_light(make_image_environment(sky, EnvironmentMapping::LatLong, Transform()));
+  CameraParams cam;
+  cam.width = 40;
+  cam.height = 28;
+  cam.fov_degrees = 55;
+  cam.lens_radius = 0.15f;
+  cam.focal_distance = 4.f;
+  cam.camera_to_world = Transform::look_at({0, 1.5f, -4.f}, {0, 0.4f, 0}, {0, 1, 0}).inverse();
+  b.set_camera(cam);
+  return b.build("corners");
+}
+
 // Builds a random complete path by tracing a light subpath (Importance mode) of 1-4 surface
 // vertices whose last vertex the camera sees. Returns false if the walk failed.
 bool random_path(const Scene& scene, Pcg32& rng, ScratchArena& arena, ExplicitPath* path) {
@@ -89,6 +130,11 @@ bool random_path(const Scene& scene, Pcg32& rng, ScratchArena& arena, ExplicitPa
     ray = si.spawn_ray(bs->wi);
   }
   path->lens_point = scene.camera().position();
+  if (!scene.camera().is_pinhole()) {  // a lens point from which the last vertex is on the film
+    const auto cs = scene.camera().sample_wi(path->surfaces.back().p, rng.next_2d());
+    if (!cs) return false;
+    path->lens_point = cs->p_lens;
+  }
   // Only paths that carry light: every non-delta vertex scatters from its predecessor toward its
   // successor (a zero BSDF there would leave the camera side unable to sample the path at all).
   for (size_t i = 0; i < path->surfaces.size(); ++i) {
@@ -99,7 +145,9 @@ bool random_path(const Scene& scene, Pcg32& rng, ScratchArena& arena, ExplicitPa
     if (bsdf.f(si.wo, normalize(next - si.p), TransportMode::Importance).is_black()) return false;
   }
   const Vec3 last = path->surfaces.back().p;
-  return scene.camera().project(last).has_value() &&
+  return scene.camera()
+             .raster_of(path->lens_point, normalize(last - path->lens_point))
+             .has_value() &&
          camera_pdf_w(scene.camera(), path->lens_point, normalize(last - path->lens_point)) > 0;
 }
 
@@ -193,12 +241,13 @@ struct Case {
   const char* scene;
   BidirAlgorithm algorithm;
   MisHeuristic heuristic;
+  float light_paths = 1024;  // N; the scenes have 32 x 32 pixels (corners: 40 x 28)
 };
 
 void check_partition_of_unity(const Scene& scene, const Case& c, int paths) {
   Pcg32 rng(7, 11);
   ScratchArena arena;
-  const float light_paths = 1024, radius = 0.02f;
+  const float light_paths = c.light_paths, radius = 0.02f;
   const bool connect = c.algorithm != BidirAlgorithm::Bpm,
              merge = c.algorithm != BidirAlgorithm::Bpt;
   int checked = 0, attempts = 0, with_delta = 0;
@@ -246,6 +295,7 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths) {
 
 std::unique_ptr<Scene> scene_named(const std::string& name) {
   if (name == "mixed-lights") return mixed_lights_scene();
+  if (name == "corners") return corners_scene();
   return make_builtin_scene(name, 32, 32);
 }
 
@@ -267,11 +317,16 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"cornell-glass", BidirAlgorithm::Bpt, MisHeuristic::Balance},
                       Case{"cornell-glass", BidirAlgorithm::Bpm, MisHeuristic::Balance},
                       Case{"mixed-lights", BidirAlgorithm::Vcm, MisHeuristic::Balance},
-                      Case{"env-furnace", BidirAlgorithm::Vcm, MisHeuristic::Power}),
+                      Case{"env-furnace", BidirAlgorithm::Vcm, MisHeuristic::Power},
+                      Case{"cornell", BidirAlgorithm::Vcm, MisHeuristic::Balance, 300},
+                      Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Balance, 700},
+                      Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Power, 5000},
+                      Case{"corners", BidirAlgorithm::Bpt, MisHeuristic::Balance, 700}),
     [](const auto& info) {
       std::string n = std::string(info.param.scene) + "_" +
                       std::to_string(int(info.param.algorithm)) + "_" +
-                      (info.param.heuristic == MisHeuristic::Power ? "power" : "balance");
+                      (info.param.heuristic == MisHeuristic::Power ? "power" : "balance") + "_N" +
+                      std::to_string(int(info.param.light_paths));
       for (char& ch : n)
         if (ch == '-') ch = '_';
       return n;

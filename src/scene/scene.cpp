@@ -33,13 +33,18 @@ void sphere_bounds(const RTCBoundsFunctionArguments* args) {
   const Sphere& s = (*g->spheres)[args->primID].sphere;
   RTCBounds* b = args->bounds_o;
   const float r = s.radius * (1 + 1e-5f);
-  b->lower_x = s.center.x - r; b->lower_y = s.center.y - r; b->lower_z = s.center.z - r;
-  b->upper_x = s.center.x + r; b->upper_y = s.center.y + r; b->upper_z = s.center.z + r;
+  b->lower_x = s.center.x - r;
+  b->lower_y = s.center.y - r;
+  b->lower_z = s.center.z - r;
+  b->upper_x = s.center.x + r;
+  b->upper_y = s.center.y + r;
+  b->upper_z = s.center.z + r;
 }
 
 // Returns the nearest root in (tnear, tfar), or -1.
 double sphere_hit(const Sphere& s, const float o[3], const float d[3], double tnear, double tfar) {
-  const double ox = double(o[0]) - s.center.x, oy = double(o[1]) - s.center.y, oz = double(o[2]) - s.center.z;
+  const double ox = double(o[0]) - s.center.x, oy = double(o[1]) - s.center.y,
+               oz = double(o[2]) - s.center.z;
   const double dx = d[0], dy = d[1], dz = d[2];
   const double a = dx * dx + dy * dy + dz * dz;
   const double b = 2 * (dx * ox + dy * oy + dz * oz);
@@ -99,7 +104,7 @@ struct Scene::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   unsigned sphere_geom_id = RTC_INVALID_GEOMETRY_ID;
-  std::vector<int> mesh_of_geom;  // Embree geometry id -> mesh index (-1: spheres)
+  std::vector<int> mesh_of_geom;          // Embree geometry id -> mesh index (-1: spheres)
   std::vector<uint32_t> first_primitive;  // Embree geometry id -> its first dense primitive index
   SphereGeometry sphere_geometry{};
   mutable tbb::enumerable_thread_specific<uint64_t> rays{0};
@@ -134,16 +139,16 @@ Scene::Scene(SceneData data)
     const TriangleMesh& m = meshes_[mi].mesh;
     if (m.triangle_count() == 0) continue;
     RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                           3 * sizeof(float), m.positions.size()));
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.positions.size()));
     for (size_t i = 0; i < m.positions.size(); ++i) {
       vb[3 * i] = m.positions[i].x;
       vb[3 * i + 1] = m.positions[i].y;
       vb[3 * i + 2] = m.positions[i].z;
       bounds_.extend(m.positions[i]);
     }
-    auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                              3 * sizeof(uint32_t), m.triangle_count()));
+    auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), m.triangle_count()));
     std::copy(m.indices.begin(), m.indices.end(), ib);
     rtcCommitGeometry(g);
     const unsigned id = rtcAttachGeometry(im.scene, g);
@@ -162,7 +167,8 @@ Scene::Scene(SceneData data)
     rtcCommitGeometry(g);
     im.sphere_geom_id = rtcAttachGeometry(im.scene, g);
     rtcReleaseGeometry(g);
-    if (im.mesh_of_geom.size() <= im.sphere_geom_id) im.mesh_of_geom.resize(im.sphere_geom_id + 1, -1);
+    if (im.mesh_of_geom.size() <= im.sphere_geom_id)
+      im.mesh_of_geom.resize(im.sphere_geom_id + 1, -1);
     for (const auto& s : spheres_) {
       bounds_.extend(s.sphere.center - Vec3(s.sphere.radius, s.sphere.radius, s.sphere.radius));
       bounds_.extend(s.sphere.center + Vec3(s.sphere.radius, s.sphere.radius, s.sphere.radius));
@@ -176,8 +182,10 @@ Scene::Scene(SceneData data)
   im.first_primitive.assign(im.mesh_of_geom.size(), 0);
   for (size_t g = 0, next = 0; g < im.mesh_of_geom.size(); ++g) {
     im.first_primitive[g] = uint32_t(next);
-    if (g == im.sphere_geom_id) next += spheres_.size();
-    else if (im.mesh_of_geom[g] >= 0) next += meshes_[im.mesh_of_geom[g]].mesh.triangle_count();
+    if (g == im.sphere_geom_id)
+      next += spheres_.size();
+    else if (im.mesh_of_geom[g] >= 0)
+      next += meshes_[im.mesh_of_geom[g]].mesh.triangle_count();
   }
   if (!im.error.empty()) throw std::runtime_error("Embree: " + im.error);
 
@@ -217,8 +225,12 @@ uint64_t Scene::rays_traced() const {
 }
 
 static void fill_ray(const Ray& r, RTCRay* out) {
-  out->org_x = r.o.x; out->org_y = r.o.y; out->org_z = r.o.z;
-  out->dir_x = r.d.x; out->dir_y = r.d.y; out->dir_z = r.d.z;
+  out->org_x = r.o.x;
+  out->org_y = r.o.y;
+  out->org_z = r.o.z;
+  out->dir_x = r.d.x;
+  out->dir_y = r.d.y;
+  out->dir_z = r.d.z;
   out->tnear = 0.f;
   out->tfar = r.tmax;
   out->time = 0.f;
@@ -286,7 +298,8 @@ void Scene::complete_hit(uint32_t geom_id, uint32_t prim_id, float b1, float b2,
 
   const auto& e = meshes_[impl_->mesh_of_geom[geom_id]];
   const TriangleMesh& m = e.mesh;
-  const uint32_t i0 = m.indices[3 * prim_id], i1 = m.indices[3 * prim_id + 1], i2 = m.indices[3 * prim_id + 2];
+  const uint32_t i0 = m.indices[3 * prim_id], i1 = m.indices[3 * prim_id + 1],
+                 i2 = m.indices[3 * prim_id + 2];
   const Vec3 p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
   const float b0 = 1.f - b1 - b2;
   si->p = p0 * b0 + p1 * b1 + p2 * b2;
@@ -324,10 +337,17 @@ uint32_t Scene::primitive_index(const SurfaceInteraction& si) const {
   return impl_->first_primitive[si.geom_id] + si.prim_id;
 }
 
+Scene::PrimitiveRange Scene::shape_primitives(const SurfaceInteraction& si) const {
+  const uint32_t first = impl_->first_primitive[si.geom_id];
+  if (si.geom_id == impl_->sphere_geom_id) return {first + si.prim_id, first + si.prim_id + 1};
+  return {first, first + uint32_t(meshes_[impl_->mesh_of_geom[si.geom_id]].mesh.triangle_count())};
+}
+
 SurfaceInteraction Scene::interaction_at(uint32_t primitive_index, Vec3 p, Vec3 wo) const {
   const auto& first = impl_->first_primitive;
   // The geometry whose range [first[g], first[g + 1]) holds the index.
-  const uint32_t geom_id = uint32_t(std::upper_bound(first.begin(), first.end(), primitive_index) - first.begin()) - 1;
+  const uint32_t geom_id =
+      uint32_t(std::upper_bound(first.begin(), first.end(), primitive_index) - first.begin()) - 1;
   const uint32_t prim_id = primitive_index - first[geom_id];
   SurfaceInteraction si;
   si.wo = wo;
@@ -335,10 +355,12 @@ SurfaceInteraction Scene::interaction_at(uint32_t primitive_index, Vec3 p, Vec3 
   if (geom_id != impl_->sphere_geom_id) {
     // Barycentrics of p's projection onto the triangle's plane.
     const TriangleMesh& m = meshes_[impl_->mesh_of_geom[geom_id]].mesh;
-    const Vec3 p0 = m.positions[m.indices[3 * prim_id]], p1 = m.positions[m.indices[3 * prim_id + 1]],
+    const Vec3 p0 = m.positions[m.indices[3 * prim_id]],
+               p1 = m.positions[m.indices[3 * prim_id + 1]],
                p2 = m.positions[m.indices[3 * prim_id + 2]];
     const Vec3 e1 = p1 - p0, e2 = p2 - p0, d = p - p0;
-    const float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), d1 = dot(d, e1), d2 = dot(d, e2);
+    const float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), d1 = dot(d, e1),
+                d2 = dot(d, e2);
     const float det = d11 * d22 - d12 * d12;
     if (det > 0) {
       b1 = clamp((d22 * d1 - d12 * d2) / det, 0.f, 1.f);

@@ -20,10 +20,10 @@ class LightSampler;
 
 // Render settings a scene file may carry (pbrt's Sampler/Integrator/Film); the CLI overrides.
 struct SceneSettings {
-  int spp = 0;               // 0: not set by the scene
-  int max_depth = 0;         // 0: not set
-  std::string integrator;    // empty: not set
-  std::string output_name;   // pbrt Film "filename", informational
+  int spp = 0;              // 0: not set by the scene
+  int max_depth = 0;        // 0: not set
+  std::string integrator;   // empty: not set
+  std::string output_name;  // pbrt Film "filename", informational
 };
 
 // Everything a loader or built-in scene hands over. Area lights are created by SceneBuilder.
@@ -80,6 +80,13 @@ class Scene {
   // intersect() reports it, with wo set to the given direction. Does not count a ray.
   uint32_t primitive_index(const SurfaceInteraction& si) const;
   SurfaceInteraction interaction_at(uint32_t primitive_index, Vec3 p, Vec3 wo) const;
+  // The dense primitive indices of the shape si lies on (a whole mesh, or one sphere): merging
+  // trusts photons on the query's own shape and tests the visibility of the others.
+  struct PrimitiveRange {
+    uint32_t begin = 0, end = 0;
+    bool contains(uint32_t i) const { return i - begin < end - begin; }
+  };
+  PrimitiveRange shape_primitives(const SurfaceInteraction& si) const;
 
  private:
   void complete_hit(uint32_t geom_id, uint32_t prim_id, float b1, float b2, Vec3 p_sphere,

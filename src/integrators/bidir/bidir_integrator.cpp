@@ -499,7 +499,7 @@ class BidirIntegrator final : public Integrator {
           next_event(scene, it, si, bsdf, beta, mis, depth, rng, acc);
           connect_to_light_path(scene, it, si, bsdf, beta, mis, depth, light_path, arena, acc);
         }
-        if (tech_.merge) merge(it, si, bsdf, beta, mis, depth, acc);
+        if (tech_.merge) merge(scene, it, si, bsdf, beta, mis, depth, acc);
       }
 
       const float uc = rng.next_float();
@@ -579,13 +579,26 @@ class BidirIntegrator final : public Integrator {
     }
   }
 
-  void merge(const Iteration& it, const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
-             const MisSums& mis, int depth, PixelAccumulator& acc) const {
+  // Merging accepts a photon only if light could have reached the query's surface through it
+  // (no leaks through zero-thickness walls):
+  //  - it lies within half the radius of the query's tangent plane (a photon on another sheet
+  //    of the same mesh, or behind a corner, is not density on this surface);
+  //  - it arrived on a side the query's BSDF scatters from (f = 0 otherwise);
+  //  - a photon on another shape (mesh or sphere) than the query must see the query: one shadow
+  //    ray from the query to a point just off the photon on the side it arrived from. Photons
+  //    on the query's own shape are trusted, so the ray is traced only near shape boundaries.
+  // Each test only removes photons; at distance 0 (the partition test's merges) all pass.
+  void merge(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
+             const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth,
+             PixelAccumulator& acc) const {
     const int max_depth = settings_.max_depth;
-    grid_.for_each_near(si.p, vertices_, [&](uint32_t index, Vec3) {
+    const Scene::PrimitiveRange own_shape = scene.shape_primitives(si);
+    const float max_off_plane = 0.5f * it.radius;
+    grid_.for_each_near(si.p, vertices_, [&](uint32_t index, Vec3 q) {
       const LightVertex& stored = vertices_[index];
       const int light_depth = bidir::light_vertex_depth(stored);
       if (light_depth + depth - 1 > max_depth) return;
+      if (std::abs(dot(q - si.p, si.ng)) > max_off_plane) return;
       const LightVertexData v = bidir::unpack_light_vertex(stored);
       // The photon's throughput carries the flux through the surface (geometric cosine); the
       // camera vertex integrates with the shading cosine: |ns . wi| / |ng . wi|, as NEE and
@@ -595,11 +608,32 @@ class BidirIntegrator final : public Integrator {
       const Rgb f =
           bsdf.f(si.wo, v.wo, TransportMode::Radiance) * (bsdf.abs_cos(v.wo) / cos_geometric);
       if (f.is_black()) return;
+      if (!own_shape.contains(v.primitive) &&
+          !photon_visible(scene, si, v.primitive, q, v.wo, it.radius))
+        return;
       const float w =
           tech_.unweighted ? 1.f : bidir::weight_merge(it.rules, v.wo, v.mis, si, bsdf, mis);
       acc.add(true, light_depth + 1, depth + 1,
               beta * f * v.throughput * (w * it.merge_normalization));
     });
+  }
+
+  // Whether light arriving along wo at the query could be the photon's (a photon on another
+  // shape than the query). Each point must lie on the lit side (the side of wo) of the other's
+  // surface, within a ten-thousandth of the radius: a photon on the far face of a
+  // zero-thickness wall, or a query behind the photon's wall, fails here. Then a shadow ray
+  // between the two, each end offset off its own surface to the side of wo, catches a wall
+  // between them (a floor continuing under the wall into the next room). The photon's hit
+  // record is rebuilt for its normal and error bounds.
+  bool photon_visible(const Scene& scene, const SurfaceInteraction& si, uint32_t primitive, Vec3 q,
+                      Vec3 wo, float radius) const {
+    const SurfaceInteraction photon = scene.interaction_at(primitive, q, wo);
+    const float tolerance = 1e-4f * radius;
+    const Vec3 n_query = face_forward(si.ng, wo), n_photon = face_forward(photon.ng, wo);
+    if (dot(q - si.p, n_query) < -tolerance || dot(si.p - q, n_photon) < -tolerance) return false;
+    const Vec3 origin = si.offset_origin(wo);
+    const Vec3 target = photon.offset_origin(wo);
+    return !scene.occluded({origin, target - origin, 1.f - 1e-6f});
   }
 
   BidirAlgorithm algorithm_;

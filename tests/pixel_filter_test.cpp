@@ -528,6 +528,15 @@ TEST(PbrtPixelFilter, IsReadWithPbrtV4Defaults) {
   EXPECT_EQ(test::count_containing(test::captured_warnings(), "\"float sigma\""), 1);
 }
 
+TEST(PbrtPixelFilter, SharedCornellBoxGetsItsTriangleOfRadiusOne) {
+  auto scene = load_pbrt(std::string(CAUSTICA_SCENES) + "/pbrt-v4/cornell-box/scene-v4.pbrt",
+                         test::capture_warning);
+  const PixelFilterParams& f = scene->camera().pixel_filter();
+  EXPECT_EQ(f.kind, PixelFilterKind::Triangle);
+  EXPECT_EQ(f.radius.x, 1.f);
+  EXPECT_EQ(f.radius.y, 1.f);
+}
+
 TEST(PbrtPixelFilter, UnknownNamesAndBadValuesAreLocatedErrors) {
   EXPECT_EQ(test::load_error(scene_with("PixelFilter \"blackman\"")),
             "test.pbrt:1:13: error: unknown pixel filter \"blackman\" (expected box, gaussian, "

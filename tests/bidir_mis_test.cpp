@@ -162,7 +162,7 @@ struct Key {
 // both directions, no Russian roulette, n = N for light tracing, merges multiply by N pi r^2.
 std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& path, bool connect,
                                      bool merge, bool power, double light_paths, double radius,
-                                     ScratchArena& arena) {
+                                     ScratchArena& arena, double raster_density = 1) {
   const Light& light = *path.light;
   const bool finite = !light.is_infinite();
   const double pmf = scene.light_sampler().pmf(&light);
@@ -198,7 +198,9 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
     const double p = delta(i) ? 1.0 : bsdf[i].pdf(wo, dir(i, i + 1), TransportMode::Importance);
     light_pdf[i + 1] = p * to_area(i, i + 1);
   }
-  camera_pdf[k - 1] = camera_pdf_w(scene.camera(), x[k], dir(k, k - 1)) * to_area(k, k - 1);
+  // The pixel filter's raster density scales the camera ray's pdf (techniques.h).
+  camera_pdf[k - 1] =
+      camera_pdf_w(scene.camera(), x[k], dir(k, k - 1)) * raster_density * to_area(k, k - 1);
   for (int i = k - 1; i >= 1; --i) {
     const Vec3 wi = i == 1 ? (finite ? dir(1, 0) : -emit) : dir(i, i - 1);
     const double p = delta(i) ? 1.0 : bsdf[i].pdf(dir(i, i + 1), wi, TransportMode::Radiance);
@@ -244,7 +246,10 @@ struct Case {
   float light_paths = 1024;  // N; the scenes have 32 x 32 pixels (corners: 40 x 28)
 };
 
-void check_partition_of_unity(const Scene& scene, const Case& c, int paths) {
+// With filter_densities, each path is weighted for a pixel whose filter has a random raster
+// density (0.01 to 4) at the path's raster point, as non-box pixel filters give.
+void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
+                              bool filter_densities = false) {
   Pcg32 rng(7, 11);
   ScratchArena arena;
   const float light_paths = c.light_paths, radius = 0.02f;
@@ -257,11 +262,12 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths) {
     ++attempts;
     arena.reset();
     if (!random_path(scene, rng, arena, &path)) continue;
-    const auto weights =
-        production_weights(scene, c.algorithm, c.heuristic, light_paths, radius, path, arena);
+    const float density = filter_densities ? 0.01f + 3.99f * rng.next_float() : 1.f;
+    const auto weights = production_weights(scene, c.algorithm, c.heuristic, light_paths, radius,
+                                            path, arena, density);
     const auto oracle =
         oracle_weights(scene, path, connect, merge, c.heuristic == MisHeuristic::Power, light_paths,
-                       radius, arena);
+                       radius, arena, density);
     if (oracle.empty() || !std::isfinite(oracle.begin()->second))
       continue;  // no technique can make it
     double sum = 0;
@@ -331,6 +337,16 @@ INSTANTIATE_TEST_SUITE_P(
         if (ch == '-') ch = '_';
       return n;
     });
+
+// Pixel filters other than the box give the camera technique a raster density other than 1
+// (render/pixel_filter.h); the renderer's weights must still sum to one and match the oracle.
+TEST(BidirMisPartition, WeightsWithPixelFilterDensitiesSumToOneAndMatchBruteForce) {
+  auto scene = scene_named("cornell-glass");
+  check_partition_of_unity(*scene, {"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Balance},
+                           3000, true);
+  check_partition_of_unity(*scene, {"cornell-glass", BidirAlgorithm::Bpt, MisHeuristic::Power},
+                           3000, true);
+}
 
 TEST(BidirLightVertex, PackingRoundTrips) {
   std::mt19937 gen(3);

@@ -13,6 +13,10 @@ float PathTracer::mis_weight(float pdf_a, float pdf_b) const {
   return settings_.mis == MisHeuristic::Power ? power_heuristic(pdf_a, pdf_b) : balance_heuristic(pdf_a, pdf_b);
 }
 
+void PathTracer::prepare(const Scene& scene, Film&) {
+  filter_ = PixelFilter(scene.camera().pixel_filter());
+}
+
 void PathTracer::render_iteration(const Scene& scene, uint32_t iteration, Film& film) {
   const Camera& camera = scene.camera();
   parallel_for_tiles(film.width(), film.height(), [&](const Tile& tile, ScratchArena& arena) {
@@ -20,11 +24,13 @@ void PathTracer::render_iteration(const Scene& scene, uint32_t iteration, Film& 
       for (int x = tile.x0; x < tile.x1; ++x) {
         const uint64_t pixel = uint64_t(y) * film.width() + x;
         Pcg32 rng = Pcg32::for_sample(pixel, iteration, settings_.seed);
-        const Vec2 jitter = rng.next_2d();
+        // Filter importance sampling (pixel_filter.h): the sample's weight is 1 for a positive
+        // filter and carries the sign of negative lobes.
+        const CameraFilterSample fs = filter_.sample_camera(x, y, rng.next_2d());
         const Vec2 lens = rng.next_2d();
-        const Ray ray = camera.generate_ray({x + jitter.x, y + jitter.y}, lens);
+        const Ray ray = camera.generate_ray(fs.raster, lens);
         arena.reset();
-        film.add_sample(x, y, radiance(scene, ray, rng, arena));
+        film.add_sample(x, y, radiance(scene, ray, rng, arena) * fs.weight);
       }
   });
 }

@@ -6,6 +6,7 @@
 #include "core/rgb.h"
 #include "core/rng.h"
 #include "integrators/integrator.h"
+#include "render/pixel_filter.h"
 
 namespace caustica {
 
@@ -13,6 +14,7 @@ class PathTracer final : public Integrator {
  public:
   explicit PathTracer(const IntegratorSettings& settings) : settings_(settings) {}
   const char* name() const override { return "pt"; }
+  void prepare(const Scene& scene, Film& film) override;
   void render_iteration(const Scene& scene, uint32_t iteration, Film& film) override;
 
   // Radiance arriving along a camera ray; exposed for tests.
@@ -21,6 +23,7 @@ class PathTracer final : public Integrator {
  private:
   float mis_weight(float pdf_a, float pdf_b) const;
   IntegratorSettings settings_;
+  PixelFilter filter_;  // the scene camera's, set by prepare()
 };
 
 }  // namespace caustica

@@ -1,5 +1,6 @@
 // The film: per-pixel sums of iteration estimates, in double precision so long renders do
-// not lose small contributions. Box pixel filter (a pixel is a plain average of its samples).
+// not lose small contributions. A pixel is the plain average of its estimates: integrators apply
+// the pixel filter by filter importance sampling and weighted splats (pixel_filter.h).
 //
 // Determinism: camera samples are written by the single task that owns the pixel in that
 // iteration; light-tracing splats are gathered in per-chunk buffers that the integrator adds
@@ -23,10 +24,11 @@ class Film {
   int height() const { return height_; }
   size_t pixel_count() const { return size_t(width_) * size_t(height_); }
 
-  // Adds one estimate to pixel (x, y) for the current iteration. Non-finite or negative
-  // values are discarded and counted: NaN/Inf never reach the image.
+  // Adds one estimate to pixel (x, y) for the current iteration. Non-finite values are
+  // discarded and counted: NaN/Inf never reach the image. Negative values are kept: filters
+  // with negative lobes (mitchell, sinc) give negative sample weights.
   void add_sample(int x, int y, Rgb value) {
-    if (!value.is_finite() || value.r < 0 || value.g < 0 || value.b < 0) {
+    if (!value.is_finite()) {
       nonfinite_.fetch_add(1, std::memory_order_relaxed);
       return;
     }

@@ -1,5 +1,6 @@
 #include "scene/camera.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/warp.h"
@@ -12,7 +13,10 @@ Camera::Camera(const CameraParams& p)
       width_(p.width),
       height_(p.height),
       lens_radius_(p.lens_radius),
-      focal_distance_(p.focal_distance) {
+      focal_distance_(p.focal_distance),
+      filter_(p.filter),
+      film_margin_(std::max(0.f, p.filter.radius.x - 0.5f),
+                   std::max(0.f, p.filter.radius.y - 0.5f)) {
   const float aspect = float(width_) / float(height_);
   if (p.screen_window[0] != p.screen_window[1]) {
     screen_min_x_ = p.screen_window[0];
@@ -58,7 +62,9 @@ std::optional<Vec2> Camera::raster_of(Vec3 p_lens, Vec3 dir) const {
   const float sx = d.x / d.z / tan_half_fov_, sy = d.y / d.z / tan_half_fov_;
   const float rx = (sx - screen_min_x_) / (screen_max_x_ - screen_min_x_) * float(width_);
   const float ry = (screen_max_y_ - sy) / (screen_max_y_ - screen_min_y_) * float(height_);
-  if (!(rx >= 0 && rx < float(width_) && ry >= 0 && ry < float(height_))) return std::nullopt;
+  if (!(rx >= -film_margin_.x && rx < float(width_) + film_margin_.x && ry >= -film_margin_.y &&
+        ry < float(height_) + film_margin_.y))
+    return std::nullopt;
   return Vec2(rx, ry);
 }
 

@@ -4,14 +4,20 @@
 //
 // Importance (for light tracing, pbrt-v4 PerspectiveCamera::We): We is normalised over the
 // whole image, We = 1 / (A * lens_area * cos^4 theta), with A the image-plane area at
-// distance 1 and lens_area = 1 for a pinhole. With the box pixel filter, the importance of
-// one pixel is pixel_count() * We.
+// distance 1 and lens_area = 1 for a pinhole. Pixel p's importance is
+// pixel_count() * We * f(r - c_p) / integral f for the pixel filter f (render/pixel_filter.h):
+// with the box of radius 1/2, pixel_count() * We inside the pixel.
+//
+// The film's sensitive region is the image widened by the filter radius less half a pixel
+// (pbrt-v4's Film::SampleBounds): camera samples of border pixels land there, so raster_of,
+// importance and pdf_we accept it too (We keeps the normalisation of the nominal image).
 #pragma once
 
 #include <optional>
 
 #include "core/transform.h"
 #include "core/vec.h"
+#include "scene/pixel_filter_params.h"
 
 namespace caustica {
 
@@ -23,6 +29,9 @@ struct CameraParams {
   float focal_distance = 1e6f;
   // Optional pbrt "screenwindow" [xmin xmax ymin ymax]; empty = derived from aspect ratio.
   float screen_window[4] = {0, 0, 0, 0};
+  // The pixel filter (pbrt-v4's PixelFilter). Built-in and glTF scenes keep this box of radius
+  // 1/2; the pbrt loader sets what the file names, else pbrt-v4's default gaussian.
+  PixelFilterParams filter;
 };
 
 struct CameraWiSample {
@@ -48,12 +57,13 @@ class Camera {
   bool is_pinhole() const { return lens_radius_ == 0; }
   float lens_area() const;
   float image_plane_area() const { return image_plane_area_; }
+  const PixelFilterParams& pixel_filter() const { return filter_; }
 
   // Ray through continuous raster position (x right, y down, in pixels) and lens sample.
   Ray generate_ray(Vec2 raster, Vec2 u_lens) const;
 
   // Raster position of the camera ray with direction dir leaving p_lens; nothing if it
-  // misses the film or points backward.
+  // misses the film's sensitive region (see above) or points backward.
   std::optional<Vec2> raster_of(Vec3 p_lens, Vec3 dir) const;
   // Raster position of a world point seen through a pinhole (convenience for tests).
   std::optional<Vec2> project(Vec3 p) const { return raster_of(origin_, normalize(p - origin_)); }
@@ -70,6 +80,8 @@ class Camera {
   float lens_radius_ = 0, focal_distance_ = 1;
   float screen_min_x_ = -1, screen_max_x_ = 1, screen_min_y_ = -1, screen_max_y_ = 1;
   float tan_half_fov_ = 1;
+  PixelFilterParams filter_;
+  Vec2 film_margin_;  // pixels beyond the image that still reach a pixel: filter radius - 1/2
   float image_plane_area_ = 4;
   Vec3 origin_, forward_;
 };

@@ -22,6 +22,7 @@
 #include "lights/light_sampler.h"
 #include "materials/material.h"
 #include "render/film.h"
+#include "render/pixel_filter.h"
 #include "render/tiles.h"
 #include "scene/scene.h"
 
@@ -171,11 +172,13 @@ struct PixelAccumulator {
   TechniqueImages* techniques = nullptr;
   size_t pixel = 0;
   uint64_t nonfinite = 0;
+  float filter_weight = 1;  // the camera sample's pixel-filter weight (pixel_filter.h)
   void add(bool merge, int s, int t, Rgb value) {
     if (!value.is_finite()) {
       ++nonfinite;
       return;
     }
+    value *= filter_weight;
     sum += value;
     if (techniques) techniques->add(TechniqueImages::key(merge, s, t), pixel, value);
   }
@@ -200,6 +203,7 @@ class BidirIntegrator final : public Integrator {
   const char* name() const override { return name_of(algorithm_); }
 
   void prepare(const Scene& scene, Film& film) override {
+    filter_ = PixelFilter(scene.camera().pixel_filter());
     Vec3 center;
     float scene_radius;
     scene.bounds().bounding_sphere(&center, &scene_radius);
@@ -393,23 +397,29 @@ class BidirIntegrator final : public Integrator {
     if (!cs || !(cs->importance > 0)) return;
     const Rgb f = bsdf.f(si.wo, cs->wi, TransportMode::Importance) * bsdf.abs_cos(cs->wi);
     if (f.is_black()) return;
-    // Pixel importance is pixel_count * We; each pixel is estimated by N light paths.
+    // Pixel importance is pixel_count * We * f(r - c_p) / integral f; each pixel is estimated by
+    // N light paths. Every pixel whose filter support holds the raster point r gets a splat,
+    // MIS-weighted against its own camera technique (raster density pdf(r - c_p)).
     const float scale =
         cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(light_paths_));
-    const float w = tech_.unweighted ? 1.f
-                                     : bidir::weight_light_to_camera(it.rules, camera, si, bsdf,
-                                                                     si.wo, mis, cs->p_lens);
-    const Rgb value = beta * f * (scale * w);
-    if (value.is_black()) return;
-    if (!value.is_finite()) {
-      ++chunk.nonfinite;
-      return;
-    }
-    if (scene.occluded(si.spawn_ray_to(cs->p_lens))) return;
-    const int x = std::min(int(cs->raster.x), camera.width() - 1),
-              y = std::min(int(cs->raster.y), camera.height() - 1);
-    chunk.splats.push_back(
-        {uint32_t(y * camera.width() + x), TechniqueImages::key(false, depth + 1, 1), value});
+    const size_t first_splat = chunk.splats.size();
+    filter_.for_each_pixel(
+        cs->raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
+          const float w = tech_.unweighted
+                              ? 1.f
+                              : bidir::weight_light_to_camera(it.rules, camera, si, bsdf, si.wo,
+                                                              mis, cs->p_lens, fs.pdf);
+          const Rgb value = beta * f * (scale * w) * (fs.weight * fs.pdf);
+          if (value.is_black()) return;
+          if (!value.is_finite()) {
+            ++chunk.nonfinite;
+            return;
+          }
+          chunk.splats.push_back(
+              {uint32_t(y * camera.width() + x), TechniqueImages::key(false, depth + 1, 1), value});
+        });
+    if (chunk.splats.size() > first_splat && scene.occluded(si.spawn_ray_to(cs->p_lens)))
+      chunk.splats.resize(first_splat);
   }
 
   // ---- camera subpaths ----------------------------------------------------------------------
@@ -438,10 +448,11 @@ class BidirIntegrator final : public Integrator {
     const LightSampler& lights = scene.light_sampler();
     const uint64_t pixel = acc.pixel;
     Pcg32 rng = Pcg32::for_sample(pixel, it.index, hash_combine(settings_.seed, 0xca3e7aull));
-    const Vec2 jitter = rng.next_2d();
+    const CameraFilterSample film_sample = filter_.sample_camera(x, y, rng.next_2d());
     const Vec2 lens = rng.next_2d();
-    Ray ray = camera.generate_ray({x + jitter.x, y + jitter.y}, lens);
-    const float pdf_camera = bidir::camera_pdf_w(camera, ray.o, ray.d);
+    Ray ray = camera.generate_ray(film_sample.raster, lens);
+    acc.filter_weight = film_sample.weight;
+    const float pdf_camera = bidir::camera_pdf_w(camera, ray.o, ray.d, film_sample.pdf);
     if (!(pdf_camera > 0)) return;
     MisSums mis = it.rules.camera_start(pdf_camera);
     const int max_depth = settings_.max_depth;
@@ -640,6 +651,7 @@ class BidirIntegrator final : public Integrator {
   Techniques tech_;
   IntegratorSettings settings_;
   MisHeuristic heuristic_;
+  PixelFilter filter_;  // the scene camera's, set by prepare()
   float base_radius_ = 0, last_radius_ = 0;
   uint64_t light_paths_ = 0;
 

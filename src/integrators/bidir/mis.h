@@ -33,7 +33,8 @@ class MisRules {
   float light_paths() const { return light_paths_; }
 
   // Camera subpath start; camera_pdf_w is the per-pixel solid-angle density of the primary ray
-  // (pixel_count * pdf_we). tech. rep. eqs. 31-33, completed by hit().
+  // (pixel_count * pdf_we * the pixel filter's raster density, techniques.h). tech. rep. eqs.
+  // 31-33, completed by hit().
   MisSums camera_start(float camera_pdf_w) const;
   // Light subpath at its first surface vertex y1 (the start and the first hit in one, since the
   // direct-sampling pdf of a sphere light depends on y1). direct_pdf: pmf * NEE density of the

@@ -12,7 +12,7 @@ namespace caustica::bidir {
 std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
                                                 MisHeuristic heuristic, float light_paths,
                                                 float radius, const ExplicitPath& path,
-                                                ScratchArena& arena) {
+                                                ScratchArena& arena, float raster_density) {
   const bool connect = algorithm != BidirAlgorithm::Bpm;
   const bool merge = algorithm != BidirAlgorithm::Bpt;
   const MisRules rules(heuristic, connect, merge, light_paths, radius);
@@ -70,7 +70,8 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
 
   // Camera subpath replay: sums at x(k-1) down to x1, and at the emitter (s = 0).
   std::vector<MisSums> camera_mis(k);
-  camera_mis[k - 1] = rules.camera_start(camera_pdf_w(scene.camera(), x[k], dir(k, k - 1)));
+  camera_mis[k - 1] =
+      rules.camera_start(camera_pdf_w(scene.camera(), x[k], dir(k, k - 1), raster_density));
   rules.hit(camera_mis[k - 1], distance_squared(x[k], x[k - 1]),
             geometric_cos(camera_si[k - 1], dir(k - 1, k)));
   for (int i = k - 2; i >= 1; --i) {
@@ -130,9 +131,10 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   }
   // t = 1: x(k-1) connected to the lens.
   if (connect && k >= 2 && !delta(k - 1)) {
-    out.push_back({false, k, 1,
-                   weight_light_to_camera(rules, scene.camera(), light_si[k - 1], bsdf[k - 1],
-                                          light_si[k - 1].wo, stored(k - 1), x[k])});
+    out.push_back(
+        {false, k, 1,
+         weight_light_to_camera(rules, scene.camera(), light_si[k - 1], bsdf[k - 1],
+                                light_si[k - 1].wo, stored(k - 1), x[k], raster_density)});
   }
   // Merges at every non-delta interior vertex.
   for (int j = 1; merge && j <= k - 1; ++j) {

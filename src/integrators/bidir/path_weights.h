@@ -35,9 +35,11 @@ struct TechniqueWeight {
 
 // Weights of every technique of `algorithm` (Bpt, Bpm or Vcm) able to produce the path
 // (delta vertices are recognised by Bsdf::is_delta; mixed BSDFs are treated as non-delta).
+// raster_density: the pixel filter's density of the path's raster offset from the centre of the
+// pixel it is estimated for (camera_pdf_w; 1 for the box of radius 1/2).
 std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
                                                 MisHeuristic heuristic, float light_paths,
                                                 float radius, const ExplicitPath& path,
-                                                ScratchArena& arena);
+                                                ScratchArena& arena, float raster_density = 1.f);
 
 }  // namespace caustica::bidir

@@ -5,12 +5,13 @@
 
 namespace caustica::bidir {
 
-float camera_pdf_w(const Camera& camera, Vec3 p_lens, Vec3 dir) {
+float camera_pdf_w(const Camera& camera, Vec3 p_lens, Vec3 dir, float raster_density) {
   float pdf_pos, pdf_dir;
   camera.pdf_we(p_lens, dir, &pdf_pos, &pdf_dir);
-  // pdf_we is normalised over the whole image; one camera sample per pixel sees pixel_count times
-  // it.
-  return float(camera.pixel_count()) * pdf_dir;
+  // pdf_we is normalised over the whole image, a raster density of 1 / pixel_count; one camera
+  // sample per pixel has the filter's raster density instead, pixel_count * raster_density times
+  // as much.
+  return float(camera.pixel_count()) * pdf_dir * raster_density;
 }
 
 MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf,
@@ -82,11 +83,12 @@ float weight_connection(const MisRules& rules, const SurfaceInteraction& light_s
 
 float weight_light_to_camera(const MisRules& rules, const Camera& camera,
                              const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
-                             const MisSums& light, Vec3 p_lens) {
+                             const MisSums& light, Vec3 p_lens, float raster_density) {
   const Vec3 d = p_lens - si.p;
   const float dist2 = length_squared(d);
   const Vec3 dir = d / std::sqrt(dist2);
-  const float camera_pdf_a = camera_pdf_w(camera, p_lens, -dir) * geometric_cos(si, dir) / dist2;
+  const float camera_pdf_a =
+      camera_pdf_w(camera, p_lens, -dir, raster_density) * geometric_cos(si, dir) / dist2;
   const float rev = bsdf.pdf(dir, wo, TransportMode::Radiance);
   return rules.light_to_camera(light, camera_pdf_a, rev);
 }

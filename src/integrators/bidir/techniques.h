@@ -22,8 +22,9 @@ namespace caustica::bidir {
 inline float geometric_cos(const SurfaceInteraction& si, Vec3 w) { return abs_dot(si.ng, w); }
 
 // Per-pixel solid-angle density of a camera ray leaving lens point p_lens along dir (0 off the
-// film).
-float camera_pdf_w(const Camera& camera, Vec3 p_lens, Vec3 dir);
+// film). raster_density: the pixel filter's density of the ray's raster offset from the pixel
+// centre, per unit raster area (render/pixel_filter.h; 1 for the box of radius 1/2).
+float camera_pdf_w(const Camera& camera, Vec3 p_lens, Vec3 dir, float raster_density = 1.f);
 
 // MIS sums at the first light vertex y1, reached at distance dist from the emission sample.
 MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf,
@@ -47,10 +48,11 @@ float weight_connection(const MisRules& rules, const SurfaceInteraction& light_s
                         const Bsdf& light_bsdf, Vec3 light_wo, const MisSums& light,
                         const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
                         const MisSums& camera);
-// Light vertex connected to the lens point p_lens.
+// Light vertex connected to the lens point p_lens, splatted to a pixel whose camera technique
+// has raster density raster_density there (camera_pdf_w).
 float weight_light_to_camera(const MisRules& rules, const Camera& camera,
                              const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
-                             const MisSums& light, Vec3 p_lens);
+                             const MisSums& light, Vec3 p_lens, float raster_density = 1.f);
 // Merge of a light vertex that arrived along light_wo with a camera vertex.
 float weight_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,
                    const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,

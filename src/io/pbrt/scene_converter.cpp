@@ -79,6 +79,7 @@ SceneConverter::SceneConverter(SceneBuilder& builder, LoaderContext& ctx)
   camera_.width = 1280;
   camera_.height = 720;
   camera_.fov_degrees = 90;
+  camera_.filter = PixelFilterParams::defaults(PixelFilterKind::Gaussian);  // pbrt-v4's default
 }
 
 void SceneConverter::directive(const Directive& d) {
@@ -305,11 +306,28 @@ void SceneConverter::handle(const Directive& d) {
   }
   if (n == "PixelFilter") {
     require_world(d, false);
-    if (d.args[0] != "box")
-      ctx_.warnings.warn(d.where,
-                         "PixelFilter \"" + d.args[0] + "\" is not supported; using a box filter",
-                         "pixel filter");
-    mark_all_used(d.params);
+    const auto kind = pixel_filter_kind(d.args[0]);
+    if (!kind)
+      throw SceneLoadError(d.arg_where[0], "unknown pixel filter \"" + d.args[0] + "\" (expected " +
+                                               kPixelFilterNames + ")");
+    PixelFilterParams& f = camera_.filter = PixelFilterParams::defaults(*kind);
+    f.radius = {d.params.get_float("xradius", f.radius.x),
+                d.params.get_float("yradius", f.radius.y)};
+    for (const char* r : {"xradius", "yradius"})
+      if (const Param* p = d.params.find(r))
+        if (!(p->numbers[0] > 0 && p->numbers[0] <= 64))
+          param_error(*p, "expected a radius greater than 0 and at most 64 pixels");
+    if (*kind == PixelFilterKind::Gaussian) {
+      f.sigma = d.params.get_float("sigma", f.sigma);
+      if (!(f.sigma > 0)) param_error(*d.params.find("sigma"), "must be positive");
+    } else if (*kind == PixelFilterKind::Mitchell) {
+      f.b = d.params.get_float("B", f.b);
+      f.c = d.params.get_float("C", f.c);
+    } else if (*kind == PixelFilterKind::Lanczos) {
+      f.tau = d.params.get_float("tau", f.tau);
+      if (!(f.tau > 0)) param_error(*d.params.find("tau"), "must be positive");
+    }
+    d.params.report_unused(ctx_.warnings, "PixelFilter \"" + d.args[0] + "\"");
     return;
   }
   if (n == "Accelerator") {

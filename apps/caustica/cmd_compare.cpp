@@ -8,7 +8,6 @@
 #include <sstream>
 
 #include "commands.h"
-#include "scene_setup.h"
 #include "experiment/comparison.h"
 #include "experiment/report.h"
 #include "image/image_io.h"
@@ -17,6 +16,7 @@
 #include "render/progress.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
+#include "scene_setup.h"
 
 namespace caustica::cli {
 
@@ -30,7 +30,8 @@ struct CommonOptions : SceneSetup {
 void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_option("scene", o.scene, "Scene name or file")->required();
   cmd->add_option("--threads", o.threads, "Worker threads (default: all cores)");
-  cmd->add_option("--max-depth", o.max_depth, "Maximum scattering vertices (default: the scene's, else 10)");
+  cmd->add_option("--max-depth", o.max_depth,
+                  "Maximum scattering vertices (default: the scene's, else 10)");
   cmd->add_option("--seed", o.seed, "Random seed");
   cmd->add_option("--resolution", o.resolution, "Override the film resolution, WxH");
   cmd->add_option("--mis", o.mis, "MIS heuristic: balance or power (default: each integrator's)");
@@ -72,18 +73,25 @@ int run_reference(const ReferenceOptions& o) {
   RenderCallbacks cb;
   cb.progress_label = "reference " + o.integrator;
   const RenderResult r = render(*scene, *integrator, budget, cb);
-  const std::string out = o.outfile.empty() ? std::filesystem::path(o.scene).stem().string() + "-ref" : o.outfile;
-  nlohmann::json meta = {{"kind", "reference"},           {"scene", o.scene},         {"integrator", o.integrator},
-                         {"seconds", r.seconds},          {"iterations", r.iterations}, {"seed", o.seed},
-                         {"threads", threads},            {"max_depth", settings.max_depth},
+  const std::string out =
+      o.outfile.empty() ? std::filesystem::path(o.scene).stem().string() + "-ref" : o.outfile;
+  nlohmann::json meta = {{"kind", "reference"},
+                         {"scene", o.scene},
+                         {"integrator", o.integrator},
+                         {"seconds", r.seconds},
+                         {"iterations", r.iterations},
+                         {"seed", o.seed},
+                         {"threads", threads},
+                         {"max_depth", settings.max_depth},
                          {"resolution", {scene->camera().width(), scene->camera().height()}},
-                         {"rays", r.rays},                {"nonfinite_samples_discarded", r.nonfinite},
+                         {"rays", r.rays},
+                         {"nonfinite_samples_discarded", r.nonfinite},
                          {"peak_memory_mb", double(peak_memory_bytes()) / (1024 * 1024)}};
   integrator->report(meta);
   const OutputPaths paths = output_paths_for(out);
   write_render_outputs(r.image, meta, paths, 0.f);
-  std::fprintf(stderr, "reference: %u iterations of %s in %.1f s -> %s (+ .png, .json)\n", r.iterations,
-               o.integrator.c_str(), r.seconds, paths.exr.c_str());
+  std::fprintf(stderr, "reference: %u iterations of %s in %.1f s -> %s (+ .png, .json)\n",
+               r.iterations, o.integrator.c_str(), r.seconds, paths.exr.c_str());
   return 0;
 }
 
@@ -107,7 +115,8 @@ int run_compare(const CompareOptions& o) {
   IntegratorSettings settings;
   if (int rc = prepare(o, &scene, &settings)) return rc;
   const int threads = o.threads > 0 ? o.threads : tbb::info::default_concurrency();
-  const std::string dir = o.out_dir.empty() ? std::filesystem::path(o.scene).stem().string() + "-compare" : o.out_dir;
+  const std::string dir =
+      o.out_dir.empty() ? std::filesystem::path(o.scene).stem().string() + "-compare" : o.out_dir;
 
   Image reference;
   std::string ref_description;
@@ -138,7 +147,8 @@ int run_compare(const CompareOptions& o) {
     const RenderResult r = render(*scene, *integrator, budget, cb);
     reference = r.image;
     std::ostringstream d;
-    d << ref_integrator << ", " << r.iterations << " iterations, " << int(r.seconds + 0.5) << " s, rendered by compare";
+    d << ref_integrator << ", " << r.iterations << " iterations, " << int(r.seconds + 0.5)
+      << " s, rendered by compare";
     ref_description = d.str();
   }
 
@@ -148,21 +158,24 @@ int run_compare(const CompareOptions& o) {
   config.threads = threads;
   config.settings = settings;
   ProgressBar bar("compare");
-  ComparisonResult result = run_comparison(*scene, reference, config, [&](double f, const std::string& name) {
-    (void)name;
-    bar.update(f, f * config.seconds * names.size(), "s rendered");
-  });
+  ComparisonResult result =
+      run_comparison(*scene, reference, config, [&](double f, const std::string& name) {
+        (void)name;
+        bar.update(f, f * config.seconds * names.size(), "s rendered");
+      });
   bar.finish();
   result.scene = o.scene;
   result.reference_description = ref_description;
   write_comparison_report(result, reference, dir);
-  std::printf("%-8s %10s %8s %12s %12s %8s %10s\n", "", "iterations", "Mrays/s", "relMSE", "relMSE-trim", "SSIM", "vs pt");
+  std::printf("%-8s %10s %8s %12s %12s %8s %10s\n", "", "iterations", "Mrays/s", "relMSE",
+              "relMSE-trim", "SSIM", "vs pt");
   for (const auto& row : comparison_summary(result)) {
     const auto& e = row["errors"];
     const bool has = row.contains("speedup_vs_pt") && row["speedup_vs_pt"].is_number();
-    std::printf("%-8s %10u %8.2f %12.4g %12.4g %8.4f %9.2fx\n", row["integrator"].get<std::string>().c_str(),
-                row["iterations"].get<uint32_t>(), row["rays_per_second"].get<double>() * 1e-6,
-                e["relmse"].get<double>(), e["relmse_trimmed"].get<double>(), e["ssim"].get<double>(),
+    std::printf("%-8s %10u %8.2f %12.4g %12.4g %8.4f %9.2fx\n",
+                row["integrator"].get<std::string>().c_str(), row["iterations"].get<uint32_t>(),
+                row["rays_per_second"].get<double>() * 1e-6, e["relmse"].get<double>(),
+                e["relmse_trimmed"].get<double>(), e["ssim"].get<double>(),
                 has ? row["speedup_vs_pt"].get<double>() : 0.0);
   }
   std::fprintf(stderr, "compare: report in %s/index.html\n", dir.c_str());
@@ -173,23 +186,30 @@ int run_compare(const CompareOptions& o) {
 
 Runner add_reference_command(CLI::App& app) {
   auto o = std::make_shared<ReferenceOptions>();
-  CLI::App* cmd = app.add_subcommand("reference", "Render a long reference image (EXR + PNG + JSON metadata)");
+  CLI::App* cmd =
+      app.add_subcommand("reference", "Render a long reference image (EXR + PNG + JSON metadata)");
   add_common(cmd, *o);
   cmd->add_option("--time", o->seconds, "Render time in seconds")->required();
   cmd->add_option("--integrator", o->integrator, "Integrator (default pt)");
-  cmd->add_option("--outfile", o->outfile, "Output name (default SCENE-ref): NAME.exr, NAME.png, NAME.json");
+  cmd->add_option("--outfile", o->outfile,
+                  "Output name (default SCENE-ref): NAME.exr, NAME.png, NAME.json");
   return [o] { return run_reference(*o); };
 }
 
 Runner add_compare_command(CLI::App& app) {
   auto o = std::make_shared<CompareOptions>();
-  CLI::App* cmd = app.add_subcommand("compare", "Equal-time comparison of integrators against a reference, with an HTML report");
+  CLI::App* cmd = app.add_subcommand(
+      "compare", "Equal-time comparison of integrators against a reference, with an HTML report");
   add_common(cmd, *o);
   cmd->add_option("--time", o->seconds, "Seconds per integrator")->required();
-  cmd->add_option("--integrators", o->integrators, "Comma-separated integrators (default pt,bpt,vcm,ppm)");
-  cmd->add_option("--reference", o->reference, "Reference EXR (default: render one first, 4x --time)");
-  cmd->add_option("--reference-integrator", o->reference_integrator, "Integrator for the reference render (default vcm, else pt)");
-  cmd->add_option("--reference-time", o->reference_seconds, "Seconds for the reference render (default 4x --time)");
+  cmd->add_option("--integrators", o->integrators,
+                  "Comma-separated integrators (default pt,bpt,vcm,ppm)");
+  cmd->add_option("--reference", o->reference,
+                  "Reference EXR (default: render one first, 4x --time)");
+  cmd->add_option("--reference-integrator", o->reference_integrator,
+                  "Integrator for the reference render (default vcm, else pt)");
+  cmd->add_option("--reference-time", o->reference_seconds,
+                  "Seconds for the reference render (default 4x --time)");
   cmd->add_option("--out", o->out_dir, "Output directory (default SCENE-compare)");
   return [o] { return run_compare(*o); };
 }

@@ -18,11 +18,11 @@ struct SceneSetup {
   std::string resolution;  // "WxH" or empty
   int max_depth = -1;      // -1: the scene's, else 10
   uint64_t seed = 0;
-  std::string mis;         // "", "balance" or "power"; empty: each integrator's default
+  std::string mis;  // "", "balance" or "power"; empty: each integrator's default
 };
 
 // Returns 0 and fills *scene / *settings, or prints the problem and returns the exit code (2).
-int load_configured_scene(const SceneSetup& setup, std::unique_ptr<Scene>* scene, IntegratorSettings* settings,
-                          double* load_seconds = nullptr);
+int load_configured_scene(const SceneSetup& setup, std::unique_ptr<Scene>* scene,
+                          IntegratorSettings* settings, double* load_seconds = nullptr);
 
 }  // namespace caustica::cli

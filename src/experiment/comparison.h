@@ -4,10 +4,9 @@
 #pragma once
 
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "image/image.h"
 #include "integrators/integrator.h"
@@ -55,8 +54,9 @@ struct ComparisonResult {
 };
 
 // progress(fraction, label) is called as the comparison advances (across all integrators).
-ComparisonResult run_comparison(const Scene& scene, const Image& reference, const ComparisonConfig& config,
-                                const std::function<void(double, const std::string&)>& progress = {});
+ComparisonResult run_comparison(
+    const Scene& scene, const Image& reference, const ComparisonConfig& config,
+    const std::function<void(double, const std::string&)>& progress = {});
 
 // Time integrator `run` would need to reach `target` relMSE, read off its convergence curve
 // (log-log interpolation between snapshots; beyond the last snapshot, Monte Carlo's

@@ -2,9 +2,8 @@
 // Each file goes through a temporary file and a rename.
 #pragma once
 
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "image/image.h"
 

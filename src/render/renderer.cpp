@@ -19,7 +19,8 @@ uint64_t peak_memory_bytes() {
 
 RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudget& budget,
                     const RenderCallbacks& callbacks) {
-  if (budget.spp <= 0 && budget.seconds <= 0) throw std::invalid_argument("render budget needs spp or seconds");
+  if (budget.spp <= 0 && budget.seconds <= 0)
+    throw std::invalid_argument("render budget needs spp or seconds");
   Film film(scene.camera().width(), scene.camera().height());
   ProgressBar progress(callbacks.progress_label, callbacks.quiet);
   const auto start = std::chrono::steady_clock::now();
@@ -49,7 +50,8 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
   }
   integrator.finish(scene, film);
   const double total = elapsed();
-  progress.update(1.0, total > 0 ? double(scene.rays_traced() - rays_before) / total * 1e-6 : 0, "Mrays/s");
+  progress.update(1.0, total > 0 ? double(scene.rays_traced() - rays_before) / total * 1e-6 : 0,
+                  "Mrays/s");
   progress.finish();
 
   RenderResult r;

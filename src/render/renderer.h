@@ -14,8 +14,8 @@ class Scene;
 class Film;
 
 struct RenderBudget {
-  int spp = 0;            // iterations (one sample per pixel each); 0 = not set
-  double seconds = 0;     // wall-clock budget; 0 = not set. Both set: whichever ends first
+  int spp = 0;         // iterations (one sample per pixel each); 0 = not set
+  double seconds = 0;  // wall-clock budget; 0 = not set. Both set: whichever ends first
 };
 
 struct RenderResult {
@@ -27,7 +27,7 @@ struct RenderResult {
 };
 
 struct RenderCallbacks {
-  bool quiet = false;             // no progress bar
+  bool quiet = false;  // no progress bar
   std::string progress_label = "render";
   // Called after every iteration with the film and the render time so far; return false to
   // stop early. Time spent inside the callback (e.g. error snapshots) is not render time:

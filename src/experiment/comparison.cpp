@@ -49,6 +49,10 @@ ComparisonResult run_comparison(const Scene& scene, const Image& reference,
   result.config = config;
   const double total = config.seconds * double(config.integrators.size());
   for (size_t k = 0; k < config.integrators.size(); ++k) {
+    if (config.stop && config.stop->load()) {
+      result.interrupted = true;
+      break;
+    }
     const std::string& name = config.integrators[k];
     auto integrator = make_integrator(name, config.settings);
     if (!integrator) throw std::invalid_argument("unknown integrator '" + name + "'");
@@ -68,7 +72,12 @@ ComparisonResult run_comparison(const Scene& scene, const Image& reference,
     };
     RenderBudget budget;
     budget.seconds = config.seconds;
+    cb.stop = config.stop;
     const RenderResult r = render(scene, *integrator, budget, cb);
+    if (r.interrupted) {
+      result.interrupted = true;
+      break;
+    }
     run.image = r.image;
     run.seconds = r.seconds;
     run.iterations = r.iterations;
@@ -78,7 +87,7 @@ ComparisonResult run_comparison(const Scene& scene, const Image& reference,
     integrator->report(run.integrator_stats);
     result.runs.push_back(std::move(run));
   }
-  if (progress) progress(1.0, "done");
+  if (progress && !result.interrupted) progress(1.0, "done");
   return result;
 }
 

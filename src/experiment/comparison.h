@@ -3,6 +3,7 @@
 // and at the end. Time spent computing errors is excluded from render time.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -44,6 +45,9 @@ struct ComparisonConfig {
   int threads = 0;  // 0 = all cores
   IntegratorSettings settings;
   double first_snapshot = 1.0;  // seconds; then doubling
+  // When it becomes true the comparison ends: the integrator rendering then is dropped (its
+  // time would not be equal to the others'), the completed ones are kept.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct ComparisonResult {
@@ -51,6 +55,7 @@ struct ComparisonResult {
   ComparisonConfig config;
   std::vector<IntegratorRun> runs;
   std::string reference_description;
+  bool interrupted = false;  // ended by config.stop: runs holds only the integrators completed
 };
 
 // progress(fraction, label) is called as the comparison advances (across all integrators).

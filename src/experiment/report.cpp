@@ -121,6 +121,7 @@ void write_comparison_report(const ComparisonResult& result, const Image& refere
   j["seconds_per_integrator"] = result.config.seconds;
   j["threads"] = result.config.threads;
   j["reference"] = result.reference_description;
+  j["interrupted"] = result.interrupted;
   j["summary"] = summary;
   j["runs"] = nlohmann::json::array();
   for (const auto& r : result.runs) {

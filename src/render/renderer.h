@@ -1,6 +1,7 @@
 // The progressive render loop: iterations until a sample or time budget is met.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -24,6 +25,7 @@ struct RenderResult {
   double seconds = 0;
   uint64_t rays = 0;
   uint64_t nonfinite = 0;
+  bool interrupted = false;  // ended by `stop` before the budget was spent
 };
 
 struct RenderCallbacks {
@@ -33,6 +35,11 @@ struct RenderCallbacks {
   // stop early. Time spent inside the callback (e.g. error snapshots) is not render time:
   // it is excluded from the time budget and from the reported seconds.
   std::function<bool(const Film&, uint32_t iterations, double seconds)> on_iteration;
+  // When it becomes true (e.g. set by the caller's SIGINT handler) the render ends after the
+  // current iteration and the result says `interrupted`. It is read only between iterations, so
+  // an iteration is never cut short, and at least one always completes: an interrupted render
+  // still has an image to write. The renderer owns no signal state; the caller does.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 // Peak resident memory of this process so far, in bytes (getrusage).

@@ -1,48 +1,18 @@
 // The command line as a user meets it: outputs, statistics, exit codes and error messages.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
+#include "cli_util.h"
 #include "image/image_io.h"
 
+using cli_test::CliRun;
+using cli_test::fresh_dir;
+using cli_test::only_stderr_file;
+using cli_test::run;
 namespace fs = std::filesystem;
-
-namespace {
-
-struct CliRun {
-  int exit_code;
-  std::string err;
-};
-
-CliRun run(const std::string& args, const fs::path& dir) {
-  const fs::path err = dir / "stderr.txt";
-  const std::string cmd = "cd '" + dir.string() + "' && " + CAUSTICA_BINARY + " " + args +
-                          " > /dev/null 2> '" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  std::ifstream f(err);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
-}
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::path(testing::TempDir()) / ("caustica_cli_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-bool only_stderr_file(const fs::path& dir) {
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.path().filename() != "stderr.txt") return false;
-  return true;
-}
-
-}  // namespace
 
 TEST(Cli, RenderWritesExrPngAndJsonStatistics) {
   const fs::path d = fresh_dir("render");

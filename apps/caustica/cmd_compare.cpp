@@ -221,6 +221,7 @@ Runner add_reference_command(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("reference", "Render a long reference image (EXR + PNG + JSON metadata)");
   auto checks = std::make_shared<CheckedOptions>(cmd);
+  cmd->footer(kInterruptHelp);
   cmd->add_option("scene", o->scene, "Scene name or file")->required();
   add_shared_options(*checks, o.get(), "Render time in seconds")->required();
   cmd->add_option("--integrator", o->integrator, "Integrator (default pt)");
@@ -235,6 +236,9 @@ Runner add_compare_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "compare", "Equal-time comparison of integrators against a reference, with an HTML report");
   auto checks = std::make_shared<CheckedOptions>(cmd);
+  cmd->footer(
+      "Ctrl-C or SIGTERM: stop; the report holds the integrators that completed their time "
+      "(exit 130 / 143); a second Ctrl-C quits at once.");
   cmd->add_option("scene", o->scene, "Scene name or file")->required();
   add_shared_options(*checks, o.get(), "Seconds per integrator")->required();
   cmd->add_option("--integrators", o->integrators,

@@ -159,6 +159,7 @@ Runner add_render_command(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("render", "Render a scene (built-in name, .pbrt or .gltf/.glb file)");
   auto checks = std::make_shared<CheckedOptions>(cmd);
+  cmd->footer(kInterruptHelp);
   cmd->add_option("scene", opts->scene_positional, "Scene name or file (default: cornell-glass)");
   cmd->add_option("--scene", opts->scene_flag,
                   "Scene name or file (same as the positional argument)");

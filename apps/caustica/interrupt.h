@@ -16,6 +16,11 @@
 
 namespace caustica::cli {
 
+// For --help of the rendering subcommands.
+inline constexpr const char* kInterruptHelp =
+    "Ctrl-C or SIGTERM while rendering: finish the current iteration, write the outputs so far "
+    "(JSON \"interrupted\": true) and exit 130 / 143; a second Ctrl-C quits at once.";
+
 // Installs the handler for SIGINT and SIGTERM (once, before any worker thread exists, so every
 // thread sees it).
 void install_interrupt_handler();

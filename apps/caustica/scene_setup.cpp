@@ -11,7 +11,7 @@ namespace caustica::cli {
 
 CLI::Option* add_shared_options(CheckedOptions& o, SharedOptions* s, const std::string& time_help) {
   CLI::Option* time =
-      o.number("--time", &s->seconds, 0, kMaxSeconds, true, time_help + " (at most 30 days)");
+      o.number("--time", &s->seconds, 0, kMaxSeconds, true, time_help + ", at most 30 days");
   o.integer("--threads", &s->threads, 0, 1024, "Worker threads, 0..1024 (default 0: all cores)");
   // Light vertices store their depth in 8 bits, hence 255.
   o.integer("--max-depth", &s->max_depth, 0, 255,

@@ -26,12 +26,15 @@ using namespace std::chrono_literals;
 
 namespace {
 
-// caustica started with fork + exec in `dir`, stderr to dir/stderr.txt, so that the test can
-// watch it and send signals to exactly this process (not a shell around it).
+// A program (caustica unless `program` says otherwise) started with fork + exec in `dir`,
+// stderr to dir/stderr.txt, so that the test can watch it and send signals to exactly this
+// process (not a shell around it).
 class Child {
  public:
-  Child(const std::vector<std::string>& args, const fs::path& dir) : err_(dir / "stderr.txt") {
-    std::vector<std::string> all = {CAUSTICA_BINARY};
+  Child(const std::vector<std::string>& args, const fs::path& dir,
+        const std::string& program = CAUSTICA_BINARY)
+      : err_(dir / "stderr.txt") {
+    std::vector<std::string> all = {program};
     all.insert(all.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (auto& a : all) argv.push_back(a.data());
@@ -45,7 +48,11 @@ class Child {
       if (err < 0 || null < 0) ::_exit(126);
       ::dup2(null, STDOUT_FILENO);
       ::dup2(err, STDERR_FILENO);
-      ::execv(argv[0], argv.data());
+      // caustica keeps a signal ignored on entry ignored; a test runner started in the
+      // background of a script would hand that on.
+      ::signal(SIGINT, SIG_DFL);
+      ::signal(SIGTERM, SIG_DFL);
+      ::execvp(argv[0], argv.data());
       ::_exit(127);
     }
   }
@@ -152,12 +159,10 @@ TEST(CliInterrupt, SigtermDuringReferenceWritesTheImageSoFarAndExits143) {
 // microseconds must still be a graceful stop, not the "second Ctrl-C" that quits at once.
 TEST(CliInterrupt, TimeoutCommandStopsGracefully) {
   const fs::path d = cli_test::fresh_dir("timeout");
-  const std::string cmd =
-      "cd '" + d.string() + "' && timeout --preserve-status -s INT 3 " + CAUSTICA_BINARY +
-      " render cornell --time 30 --resolution 256x256 --threads 1 --outfile out 2> stderr.txt";
-  const int status = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 130);
+  Child c({"--preserve-status", "-s", "INT", "3", CAUSTICA_BINARY, "render", "cornell", "--time",
+           "30", "--resolution", "256x256", "--threads", "1", "--outfile", "out"},
+          d, "timeout");
+  EXPECT_EQ(c.wait_exit(30s), 130) << c.stderr_text();
   expect_interrupted_outputs(d, "out", 256, 256);
 }
 

@@ -73,8 +73,13 @@ void install_interrupt_handler() {
   sigaddset(&action.sa_mask, SIGTERM);
   // Restart interrupted system calls: a signal must not turn a write(2) into a failed output.
   action.sa_flags = SA_RESTART;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
+  for (const int sig : {SIGINT, SIGTERM}) {
+    // A signal ignored on entry stays ignored (a background job of a non-interactive shell
+    // ignores SIGINT so that Ctrl-C meant for the foreground does not reach it).
+    struct sigaction previous {};
+    if (sigaction(sig, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN) continue;
+    sigaction(sig, &action, nullptr);
+  }
 }
 
 void arm_graceful_stop() { graceful.store(true); }

@@ -22,7 +22,7 @@ inline constexpr const char* kInterruptHelp =
     "(JSON \"interrupted\": true) and exit 130 / 143; a second Ctrl-C quits at once.";
 
 // Installs the handler for SIGINT and SIGTERM (once, before any worker thread exists, so every
-// thread sees it).
+// thread sees it), except for a signal that was ignored when the process started.
 void install_interrupt_handler();
 
 // From now on the first signal asks the render to stop instead of quitting.

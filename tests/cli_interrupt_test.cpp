@@ -63,7 +63,12 @@ class Child {
     }
   }
 
-  void signal(int sig) const { ::kill(pid_, sig); }
+  bool started() const { return pid_ > 0; }
+
+  // Never kill(-1, ...) (every process) after a failed fork, nor a pid reaped and reusable.
+  void signal(int sig) const {
+    if (pid_ > 0 && !reaped_) ::kill(pid_, sig);
+  }
 
   std::string stderr_text() const {
     std::ifstream f(err_);
@@ -87,12 +92,13 @@ class Child {
   // The exit code; 1000 + signal if killed by one; -1 if still running after `limit` (then killed).
   int wait_exit(std::chrono::milliseconds limit) {
     wait_until([] { return false; }, limit, 10ms);
-    if (!exited()) return -1;
+    if (!exited() || pid_ <= 0) return -1;
     return WIFEXITED(status_) ? WEXITSTATUS(status_) : 1000 + WTERMSIG(status_);
   }
 
  private:
   bool exited() {
+    if (pid_ <= 0) return true;
     if (!reaped_ && ::waitpid(pid_, &status_, WNOHANG) == pid_) reaped_ = true;
     return reaped_;
   }
@@ -138,6 +144,7 @@ TEST(CliInterrupt, SigintDuringRenderWritesTheImageSoFarAndExits130) {
   Child c({"render", "cornell", "--time", "30", "--resolution", "16x12", "--threads", "1",
            "--outfile", "out"},
           d);
+  ASSERT_TRUE(c.started());
   ASSERT_TRUE(c.wait_until([&] { return rendering(c); }, 30s)) << c.stderr_text();
   c.signal(SIGINT);
   EXPECT_EQ(c.wait_exit(20s), 130) << c.stderr_text();
@@ -149,6 +156,7 @@ TEST(CliInterrupt, SigtermDuringReferenceWritesTheImageSoFarAndExits143) {
   Child c({"reference", "cornell", "--time", "30", "--resolution", "16x12", "--threads", "1",
            "--outfile", "ref"},
           d);
+  ASSERT_TRUE(c.started());
   ASSERT_TRUE(c.wait_until([&] { return rendering(c); }, 30s)) << c.stderr_text();
   c.signal(SIGTERM);
   EXPECT_EQ(c.wait_exit(20s), 143) << c.stderr_text();
@@ -162,6 +170,7 @@ TEST(CliInterrupt, TimeoutCommandStopsGracefully) {
   Child c({"--preserve-status", "-s", "INT", "3", CAUSTICA_BINARY, "render", "cornell", "--time",
            "30", "--resolution", "256x256", "--threads", "1", "--outfile", "out"},
           d, "timeout");
+  ASSERT_TRUE(c.started());
   EXPECT_EQ(c.wait_exit(30s), 130) << c.stderr_text();
   expect_interrupted_outputs(d, "out", 256, 256);
 }
@@ -175,6 +184,7 @@ TEST(CliInterrupt, TwoSignalsMillisecondsApartAreOneRequest) {
   Child c({"render", "cornell", "--time", "30", "--resolution", "256x256", "--threads", "1",
            "--outfile", "out"},
           d);
+  ASSERT_TRUE(c.started());
   ASSERT_TRUE(c.wait_until([&] { return rendering(c); }, 30s)) << c.stderr_text();
   c.signal(SIGINT);
   std::this_thread::sleep_for(5ms);
@@ -190,6 +200,7 @@ TEST(CliInterrupt, SecondSigintQuitsAtOnceWithoutWriting) {
   Child c({"render", "cornell", "--time", "60", "--resolution", "1024x1024", "--threads", "1",
            "--outfile", "out"},
           d);
+  ASSERT_TRUE(c.started());
   ASSERT_TRUE(c.wait_until([&] { return rendering(c); }, 60s)) << c.stderr_text();
   c.signal(SIGINT);
   ASSERT_TRUE(
@@ -212,6 +223,7 @@ TEST(CliInterrupt, SecondSignalWhileWritingLeavesNoTemporaryFile) {
     Child c({"render", "cornell", "--time", "60", "--resolution", "1024x1024", "--threads", "1",
              "--outfile", "out"},
             d);
+    ASSERT_TRUE(c.started());
     ASSERT_TRUE(c.wait_until([&] { return rendering(c); }, 60s)) << c.stderr_text();
     c.signal(SIGINT);
     std::this_thread::sleep_for(150ms);  // so the next signal is a second request, not a duplicate
@@ -239,6 +251,7 @@ TEST(CliInterrupt, CompareKeepsTheIntegratorsItCompleted) {
   Child c({"compare", "cornell", "--integrators", "pt,bpt", "--time", "2", "--resolution", "16x12",
            "--threads", "1", "--reference", "ref.exr", "--out", "cmp"},
           d);
+  ASSERT_TRUE(c.started());
   // Progress passes 50% when pt's two seconds are spent and bpt renders.
   const auto past_half = [&] {
     const std::string err = c.stderr_text();

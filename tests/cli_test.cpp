@@ -1,48 +1,18 @@
 // The command line as a user meets it: outputs, statistics, exit codes and error messages.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
 
+#include "cli_util.h"
 #include "image/image_io.h"
 
+using cli_test::CliRun;
+using cli_test::fresh_dir;
+using cli_test::only_stderr_file;
+using cli_test::run;
 namespace fs = std::filesystem;
-
-namespace {
-
-struct CliRun {
-  int exit_code;
-  std::string err;
-};
-
-CliRun run(const std::string& args, const fs::path& dir) {
-  const fs::path err = dir / "stderr.txt";
-  const std::string cmd = "cd '" + dir.string() + "' && " + CAUSTICA_BINARY + " " + args + " > /dev/null 2> '" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  std::ifstream f(err);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
-}
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::path(testing::TempDir()) / ("caustica_cli_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-bool only_stderr_file(const fs::path& dir) {
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.path().filename() != "stderr.txt") return false;
-  return true;
-}
-
-}  // namespace
 
 TEST(Cli, RenderWritesExrPngAndJsonStatistics) {
   const fs::path d = fresh_dir("render");
@@ -61,7 +31,8 @@ TEST(Cli, RenderWritesExrPngAndJsonStatistics) {
   EXPECT_GT(j["rays"].get<uint64_t>(), 24u * 16u * 2u);
   EXPECT_GT(j["rays_per_second"].get<double>(), 0.0);
   EXPECT_EQ(j["nonfinite_samples_discarded"], 0);
-  for (const char* key : {"seconds", "iterations", "threads", "max_depth", "scene"}) EXPECT_TRUE(j.contains(key)) << key;
+  for (const char* key : {"seconds", "iterations", "threads", "max_depth", "scene"})
+    EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_GT(j["peak_memory_mb"].get<double>(), 1.0);
   EXPECT_LT(j["peak_memory_mb"].get<double>(), 4096.0);
 }
@@ -81,8 +52,9 @@ TEST(Cli, UnknownNamesListTheValidOnesAndExitWith2) {
 
 TEST(Cli, MalformedSceneFileGivesOneLocatedErrorAndNoImage) {
   const fs::path d = fresh_dir("malformed");
-  std::ofstream(d / "bad.pbrt") << "LookAt 0 0 0  0 1 0  0 0 1\nCamera \"perspective\" \"float fov\" [ 45 ]\n"
-                                   "WorldBegin\nShape \"sphere\" \"float radius\" [ oops ]\n";
+  std::ofstream(d / "bad.pbrt")
+      << "LookAt 0 0 0  0 1 0  0 0 1\nCamera \"perspective\" \"float fov\" [ 45 ]\n"
+         "WorldBegin\nShape \"sphere\" \"float radius\" [ oops ]\n";
   const CliRun r = run("render bad.pbrt --spp 1 --outfile out", d);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("bad.pbrt:4:"), std::string::npos) << r.err;

@@ -5,38 +5,33 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <limits>
 #include <memory>
 #include <string>
 
 #include "commands.h"
-#include "scene_setup.h"
 #include "integrators/registry.h"
+#include "interrupt.h"
 #include "io/builtin_scenes.h"
 #include "io/scene_loader.h"
+#include "preflight.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
+#include "scene_setup.h"
 
 namespace caustica::cli {
 
 namespace {
 
-struct RenderOptions {
+struct RenderOptions : SharedOptions {
   std::string scene_positional, scene_flag;
   std::string integrator;
   int spp = 0;
-  double seconds = 0;
-  int max_depth = -1;
-  uint64_t seed = 0;
-  int threads = 0;
   std::string outfile = "caustica.exr";
   float exposure = 0;
-  std::string mis;  // empty: each integrator's default (pt: power, the bidirectional family: balance)
-  std::string resolution;
-  uint64_t light_paths = 0;
   float radius = 0, radius_alpha = 0.75f;
   std::string techniques_dir;
-  int camera = -1;
   bool quiet = false;
 };
 
@@ -56,25 +51,31 @@ std::string iso_time_now() {
   return buf;
 }
 
-int run_render(const RenderOptions& o) {
+int run_render(const RenderOptions& o, const CheckedOptions& checks) {
+  if (!checks.check()) return 2;
   if (!o.scene_positional.empty() && !o.scene_flag.empty() && o.scene_positional != o.scene_flag) {
-    std::fprintf(stderr, "caustica render: error: give the scene once (positional or --scene)\n");
+    print_error("give the scene once (positional or --scene)");
     return 2;
   }
   std::string scene_name = !o.scene_flag.empty() ? o.scene_flag : o.scene_positional;
   if (scene_name.empty()) scene_name = default_scene_name();
-  if (o.spp < 0 || o.seconds < 0 || o.threads < 0) {
-    std::fprintf(stderr, "caustica render: error: --spp, --time and --threads must not be negative\n");
+  if (!o.integrator.empty() && !check_name("integrator", o.integrator, integrator_names()))
     return 2;
-  }
-  if (!o.integrator.empty() && !check_name("integrator", o.integrator, integrator_names())) return 2;
-  SceneSetup setup;
+  SceneSetup setup = o;  // the shared part of the options
   setup.scene = scene_name;
-  setup.camera = o.camera;
-  setup.resolution = o.resolution;
-  setup.max_depth = o.max_depth;
-  setup.seed = o.seed;
-  setup.mis = o.mis;
+  const OutputPaths paths = output_paths_for(o.outfile);
+  {
+    FileSection probing;  // the writability probes create a file
+    if (std::string problem = output_problem(paths); !problem.empty()) {
+      print_error("--outfile: " + problem);
+      return 2;
+    }
+    if (!o.techniques_dir.empty())
+      if (std::string problem = output_dir_problem(o.techniques_dir); !problem.empty()) {
+        print_error("--techniques: " + problem);
+        return 2;
+      }
+  }
   std::unique_ptr<Scene> scene;
   IntegratorSettings settings;
   double load_seconds = 0;
@@ -96,13 +97,16 @@ int run_render(const RenderOptions& o) {
   RenderBudget budget;
   budget.spp = o.spp;
   budget.seconds = o.seconds;
-  if (budget.spp == 0 && budget.seconds == 0) budget.spp = scene->settings().spp > 0 ? scene->settings().spp : 16;
+  if (budget.spp == 0 && budget.seconds == 0)
+    budget.spp = scene->settings().spp > 0 ? scene->settings().spp : 16;
 
   const int threads = o.threads > 0 ? o.threads : tbb::info::default_concurrency();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
   RenderCallbacks callbacks;
   callbacks.quiet = o.quiet;
   callbacks.progress_label = integrator_name;
+  callbacks.stop = stop_flag();
+  arm_graceful_stop();
   const RenderResult result = render(*scene, *integrator, budget, callbacks);
 
   nlohmann::json stats;
@@ -110,6 +114,7 @@ int run_render(const RenderOptions& o) {
   stats["integrator"] = integrator_name;
   stats["resolution"] = {scene->camera().width(), scene->camera().height()};
   stats["iterations"] = result.iterations;
+  stats["interrupted"] = result.interrupted;
   stats["spp"] = result.iterations;
   stats["seconds"] = result.seconds;
   stats["scene_load_seconds"] = load_seconds;
@@ -125,57 +130,72 @@ int run_render(const RenderOptions& o) {
   stats["finished_at"] = iso_time_now();
   integrator->report(stats);
 
-  const OutputPaths paths = output_paths_for(o.outfile);
-  write_render_outputs(result.image, stats, paths, o.exposure);
+  {
+    FileSection writing;
+    write_render_outputs(result.image, stats, paths, o.exposure);
+  }
   if (!o.quiet)
-    std::fprintf(stderr, "%s: %u spp in %.2f s (%.2f Mrays/s) -> %s, %s, %s\n", integrator_name.c_str(), result.iterations,
-                 result.seconds, result.seconds > 0 ? result.rays / result.seconds * 1e-6 : 0.0, paths.exr.c_str(),
+    std::fprintf(stderr, "%s: %u spp in %.2f s (%.2f Mrays/s) -> %s, %s, %s\n",
+                 integrator_name.c_str(), result.iterations, result.seconds,
+                 result.seconds > 0 ? result.rays / result.seconds * 1e-6 : 0.0, paths.exr.c_str(),
                  paths.png.c_str(), paths.json.c_str());
-  return 0;
+  return exit_code_after_signals(0);
 }
 
 }  // namespace
 
-bool check_name(const std::string& what, const std::string& value, const std::vector<std::string>& valid) {
+bool check_name(const std::string& what, const std::string& value,
+                const std::vector<std::string>& valid) {
   for (const auto& v : valid)
     if (v == value) return true;
   std::string list;
   for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
-  std::fprintf(stderr, "caustica: error: unknown %s '%s'; valid: %s\n", what.c_str(), value.c_str(), list.c_str());
+  print_error("unknown " + what + " " + excerpt(value) + "; valid: " + list);
   return false;
 }
 
 Runner add_render_command(CLI::App& app) {
   auto opts = std::make_shared<RenderOptions>();
-  CLI::App* cmd = app.add_subcommand("render", "Render a scene (built-in name, .pbrt or .gltf/.glb file)");
+  CLI::App* cmd =
+      app.add_subcommand("render", "Render a scene (built-in name, .pbrt or .gltf/.glb file)");
+  auto checks = std::make_shared<CheckedOptions>(cmd);
+  cmd->footer(kInterruptHelp);
   cmd->add_option("scene", opts->scene_positional, "Scene name or file (default: cornell-glass)");
-  cmd->add_option("--scene", opts->scene_flag, "Scene name or file (same as the positional argument)");
+  cmd->add_option("--scene", opts->scene_flag,
+                  "Scene name or file (same as the positional argument)");
   std::string names;
   for (const auto& n : integrator_names()) names += (names.empty() ? "" : ", ") + n;
-  cmd->add_option("--integrator", opts->integrator, "Integrator: " + names + " (default: the scene's, else pt)");
-  cmd->add_option("--spp", opts->spp, "Samples (iterations) per pixel (default: the scene's, else 16)");
-  cmd->add_option("--time", opts->seconds, "Time budget in seconds (iterations until it is spent)");
-  cmd->add_option("--max-depth", opts->max_depth, "Maximum scattering vertices (pbrt-v4 maxdepth; 1 = direct light)");
-  cmd->add_option("--seed", opts->seed, "Random seed (default 0)");
-  cmd->add_option("--threads", opts->threads, "Worker threads (default: all cores)");
-  cmd->add_option("--outfile", opts->outfile, "Output file; writes NAME.exr, NAME.png and NAME.json (default caustica.exr)");
-  cmd->add_option("--exposure", opts->exposure, "PNG exposure in stops (EXR is never tone mapped)");
-  cmd->add_option("--mis", opts->mis, "MIS heuristic: balance or power (default: power for pt, balance for lt/bpt/ppm/bpm/vcm)");
-  cmd->add_option("--resolution", opts->resolution, "Override the film resolution, WxH");
-  cmd->add_option("--light-paths", opts->light_paths, "Bidirectional: light subpaths per iteration (default: pixel count)");
-  cmd->add_option("--radius", opts->radius, "Photon mapping / VCM: initial merge radius (default: from scene size)");
-  cmd->add_option("--radius-alpha", opts->radius_alpha, "Photon mapping / VCM: radius reduction alpha (default 0.75)");
-  cmd->add_option("--techniques", opts->techniques_dir, "Bidirectional: write one weighted image per technique to DIR");
-  cmd->add_option("--camera", opts->camera, "glTF: which camera to use, in node order (default: the first)");
+  cmd->add_option("--integrator", opts->integrator,
+                  "Integrator: " + names + " (default: the scene's, else pt)");
+  checks->integer("--spp", &opts->spp, 1, std::numeric_limits<int>::max(),
+                  "Samples (iterations) per pixel, at least 1 (default: the scene's, else 16)");
+  add_shared_options(*checks, opts.get(), "Time budget in seconds (iterations until it is spent)");
+  cmd->add_option("--outfile", opts->outfile,
+                  "Output file; writes NAME.exr, NAME.png and NAME.json (default caustica.exr); "
+                  "its folder must exist and be writable");
+  checks->number("--exposure", &opts->exposure, -64, 64, false,
+                 "PNG exposure in stops, -64..64 (EXR is never tone mapped)");
+  checks->integer(
+      "--light-paths", &opts->light_paths, uint64_t(1), kMaxLightPaths,
+      "Bidirectional: light subpaths per iteration (default: pixel count); at most 2^31-2, as the "
+      "integrators index paths with 32 bits, and at most what memory holds at 40 bytes per path");
+  checks->number("--radius", &opts->radius, 0, 1e12, true,
+                 "Photon mapping / VCM: initial merge radius, positive, at most 1e12 so that "
+                 "pi r^2 times the light paths stays a finite float (default: from scene size)");
+  checks->number("--radius-alpha", &opts->radius_alpha, 0, 1, true,
+                 "Photon mapping / VCM: radius reduction alpha in (0, 1] (default 0.75)");
+  cmd->add_option("--techniques", opts->techniques_dir,
+                  "Bidirectional: write one weighted image per technique to DIR");
   cmd->add_flag("--quiet,-q", opts->quiet, "No progress bar or summary");
-  return [opts] { return run_render(*opts); };
+  return [opts, checks] { return run_render(*opts, *checks); };
 }
 
 Runner add_scenes_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("scenes", "List the built-in scenes");
   (void)cmd;
   return [] {
-    for (const auto& s : builtin_scenes()) std::printf("%-16s %s\n", s.name.c_str(), s.description.c_str());
+    for (const auto& s : builtin_scenes())
+      std::printf("%-16s %s\n", s.name.c_str(), s.description.c_str());
     return 0;
   };
 }

@@ -2,9 +2,8 @@
 // returns the process exit code when run: 0 success, 1 runtime failure, 2 bad input.
 #pragma once
 
-#include <functional>
-
 #include <CLI/CLI.hpp>
+#include <functional>
 
 namespace caustica::cli {
 
@@ -17,6 +16,7 @@ Runner add_compare_command(CLI::App& app);
 
 // Parses a name against a list; on failure prints "unknown <what> 'x'; valid: a, b" and
 // returns false.
-bool check_name(const std::string& what, const std::string& value, const std::vector<std::string>& valid);
+bool check_name(const std::string& what, const std::string& value,
+                const std::vector<std::string>& valid);
 
 }  // namespace caustica::cli

@@ -5,6 +5,8 @@
 #include <string>
 
 #include "commands.h"
+#include "interrupt.h"
+#include "options.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"caustica: a physically based renderer for comparing light transport algorithms"};
@@ -26,15 +28,18 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    // One line, like every other input error (app.exit() would add a second).
+    caustica::cli::print_error(std::string(e.what()) + " (see --help)");
     return 2;
   }
+  // Before any subcommand starts a worker thread, so that every thread runs with it.
+  caustica::cli::install_interrupt_handler();
   for (auto& [sub, run] : runners)
     if (sub->parsed()) {
       try {
         return run();
       } catch (const std::exception& e) {
-        std::fprintf(stderr, "caustica: error: %s\n", e.what());
+        caustica::cli::print_error(e.what());
         return 1;
       }
     }

@@ -1,35 +1,72 @@
 #include "scene_setup.h"
 
 #include <chrono>
-#include <cstdio>
+#include <cstdint>
+#include <limits>
 
-#include "commands.h"
 #include "io/scene_loader.h"
+#include "preflight.h"
 
 namespace caustica::cli {
 
-int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene, IntegratorSettings* settings,
-                          double* load_seconds) {
-  if (!s.mis.empty() && !check_name("MIS heuristic", s.mis, {"balance", "power"})) return 2;
-  int w = 0, h = 0;
-  if (!s.resolution.empty() && (std::sscanf(s.resolution.c_str(), "%dx%d", &w, &h) != 2 || w <= 0 || h <= 0)) {
-    std::fprintf(stderr, "caustica: error: --resolution expects WxH, e.g. 256x256, got '%s'\n", s.resolution.c_str());
-    return 2;
-  }
+CLI::Option* add_shared_options(CheckedOptions& o, SharedOptions* s, const std::string& time_help) {
+  CLI::Option* time =
+      o.number("--time", &s->seconds, 0, kMaxSeconds, true, time_help + ", at most 30 days");
+  o.integer("--threads", &s->threads, 0, 1024, "Worker threads, 0..1024 (default 0: all cores)");
+  // Light vertices store their depth in 8 bits, hence 255.
+  o.integer("--max-depth", &s->max_depth, 0, 255,
+            "Maximum scattering vertices, 0..255 (pbrt-v4 maxdepth; 1 = direct light; default: the "
+            "scene's, else 10)");
+  o.integer("--seed", &s->seed, uint64_t(0), std::numeric_limits<uint64_t>::max(),
+            "Random seed (default 0)");
+  o.resolution("--resolution", &s->width, &s->height,
+               "Override the film resolution, WxH (must fit in memory)");
+  o.choice("--mis", &s->mis, {"balance", "power"},
+           "MIS heuristic: balance or power (default: power for pt, balance for the bidirectional "
+           "family)");
+  o.integer("--camera", &s->camera, 0, std::numeric_limits<int>::max(),
+            "glTF: which camera to use, in node order (default: the first)");
+  return time;
+}
+
+namespace {
+
+int check_before_loading(const SceneSetup& s) {
+  std::string problem = scene_path_problem(s.scene);
+  if (problem.empty() && s.width > 0)
+    problem = film_memory_problem(s.width, s.height, s.light_paths);
+  if (problem.empty()) return 0;
+  print_error(problem);
+  return 2;
+}
+
+}  // namespace
+
+int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene,
+                          IntegratorSettings* settings, double* load_seconds) {
+  if (int rc = check_before_loading(s)) return rc;
   const auto start = std::chrono::steady_clock::now();
   try {
     LoadOptions load;
     load.camera_index = s.camera;
     *scene = load_scene(s.scene, load);
   } catch (const UnknownSceneError& e) {
-    std::fprintf(stderr, "caustica: error: %s\n", e.what());
+    print_error(e.what());  // quotes the user's name: keep it one line
     return 2;
   } catch (const SceneLoadError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
   }
-  if (load_seconds) *load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (w > 0) (*scene)->override_resolution(w, h);
+  if (load_seconds)
+    *load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (s.width > 0) (*scene)->override_resolution(s.width, s.height);
+  // The scene file's own resolution has not been checked yet.
+  const std::string problem =
+      film_memory_problem((*scene)->camera().width(), (*scene)->camera().height(), s.light_paths);
+  if (!problem.empty()) {
+    print_error(problem);
+    return 2;
+  }
   const int scene_depth = (*scene)->settings().max_depth;
   settings->max_depth = s.max_depth >= 0 ? s.max_depth : (scene_depth > 0 ? scene_depth : 10);
   settings->seed = s.seed;

@@ -24,24 +24,35 @@ ErrorMetrics compute_errors(const Image& image, const Image& reference) {
 }
 
 nlohmann::json to_json(const ErrorMetrics& e) {
-  return {{"mse", e.mse}, {"rmse", e.rmse}, {"relmse", e.rel_mse}, {"relmse_trimmed", e.rel_mse_trimmed}, {"ssim", e.ssim}};
+  return {{"mse", e.mse},
+          {"rmse", e.rmse},
+          {"relmse", e.rel_mse},
+          {"relmse_trimmed", e.rel_mse_trimmed},
+          {"ssim", e.ssim}};
 }
 
-ComparisonResult run_comparison(const Scene& scene, const Image& reference, const ComparisonConfig& config,
+ComparisonResult run_comparison(const Scene& scene, const Image& reference,
+                                const ComparisonConfig& config,
                                 const std::function<void(double, const std::string&)>& progress) {
   if (reference.width() != scene.camera().width() || reference.height() != scene.camera().height())
     throw std::runtime_error("reference is " + std::to_string(reference.width()) + "x" +
                              std::to_string(reference.height()) + " but the scene renders " +
-                             std::to_string(scene.camera().width()) + "x" + std::to_string(scene.camera().height()));
+                             std::to_string(scene.camera().width()) + "x" +
+                             std::to_string(scene.camera().height()));
   std::unique_ptr<tbb::global_control> limit;
   if (config.threads > 0)
-    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(config.threads));
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                  size_t(config.threads));
 
   ComparisonResult result;
   result.scene = scene.name();
   result.config = config;
   const double total = config.seconds * double(config.integrators.size());
   for (size_t k = 0; k < config.integrators.size(); ++k) {
+    if (config.stop && config.stop->load()) {
+      result.interrupted = true;
+      break;
+    }
     const std::string& name = config.integrators[k];
     auto integrator = make_integrator(name, config.settings);
     if (!integrator) throw std::invalid_argument("unknown integrator '" + name + "'");
@@ -55,12 +66,18 @@ ComparisonResult run_comparison(const Scene& scene, const Image& reference, cons
         run.snapshots.push_back({seconds, iterations, compute_errors(film.image(), reference)});
         while (next_snapshot <= seconds) next_snapshot *= 2;
       }
-      if (progress) progress((double(k) * config.seconds + std::min(seconds, config.seconds)) / total, name);
+      if (progress)
+        progress((double(k) * config.seconds + std::min(seconds, config.seconds)) / total, name);
       return true;
     };
     RenderBudget budget;
     budget.seconds = config.seconds;
+    cb.stop = config.stop;
     const RenderResult r = render(scene, *integrator, budget, cb);
+    if (r.interrupted) {
+      result.interrupted = true;
+      break;
+    }
     run.image = r.image;
     run.seconds = r.seconds;
     run.iterations = r.iterations;
@@ -70,7 +87,7 @@ ComparisonResult run_comparison(const Scene& scene, const Image& reference, cons
     integrator->report(run.integrator_stats);
     result.runs.push_back(std::move(run));
   }
-  if (progress) progress(1.0, "done");
+  if (progress && !result.interrupted) progress(1.0, "done");
   return result;
 }
 
@@ -79,7 +96,8 @@ double time_to_rel_mse(const IntegratorRun& run, double target) {
   if (s.empty() || !(target > 0)) return -1;
   for (size_t i = 0; i < s.size(); ++i) {
     if (s[i].errors.rel_mse <= target) {
-      if (i == 0) return s[0].seconds * s[0].errors.rel_mse / target;  // ~1/t before the first point
+      if (i == 0)
+        return s[0].seconds * s[0].errors.rel_mse / target;  // ~1/t before the first point
       // Log-log interpolation between snapshots i-1 and i.
       const double t0 = std::log(s[i - 1].seconds), t1 = std::log(s[i].seconds);
       const double e0 = std::log(s[i - 1].errors.rel_mse), e1 = std::log(s[i].errors.rel_mse);

@@ -3,11 +3,11 @@
 // and at the end. Time spent computing errors is excluded from render time.
 #pragma once
 
+#include <atomic>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "image/image.h"
 #include "integrators/integrator.h"
@@ -45,6 +45,9 @@ struct ComparisonConfig {
   int threads = 0;  // 0 = all cores
   IntegratorSettings settings;
   double first_snapshot = 1.0;  // seconds; then doubling
+  // When it becomes true the comparison ends: the integrator rendering then is dropped (its
+  // time would not be equal to the others'), the completed ones are kept.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct ComparisonResult {
@@ -52,11 +55,13 @@ struct ComparisonResult {
   ComparisonConfig config;
   std::vector<IntegratorRun> runs;
   std::string reference_description;
+  bool interrupted = false;  // ended by config.stop: runs holds only the integrators completed
 };
 
 // progress(fraction, label) is called as the comparison advances (across all integrators).
-ComparisonResult run_comparison(const Scene& scene, const Image& reference, const ComparisonConfig& config,
-                                const std::function<void(double, const std::string&)>& progress = {});
+ComparisonResult run_comparison(
+    const Scene& scene, const Image& reference, const ComparisonConfig& config,
+    const std::function<void(double, const std::string&)>& progress = {});
 
 // Time integrator `run` would need to reach `target` relMSE, read off its convergence curve
 // (log-log interpolation between snapshots; beyond the last snapshot, Monte Carlo's

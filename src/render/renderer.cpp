@@ -19,7 +19,8 @@ uint64_t peak_memory_bytes() {
 
 RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudget& budget,
                     const RenderCallbacks& callbacks) {
-  if (budget.spp <= 0 && budget.seconds <= 0) throw std::invalid_argument("render budget needs spp or seconds");
+  if (budget.spp <= 0 && budget.seconds <= 0)
+    throw std::invalid_argument("render budget needs spp or seconds");
   Film film(scene.camera().width(), scene.camera().height());
   ProgressBar progress(callbacks.progress_label, callbacks.quiet);
   const auto start = std::chrono::steady_clock::now();
@@ -30,9 +31,16 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
   };
 
   integrator.prepare(scene, film);
+  bool interrupted = false;
   for (uint32_t it = 0;; ++it) {
     if (budget.spp > 0 && it >= uint32_t(budget.spp)) break;
     if (budget.seconds > 0 && it > 0 && elapsed() >= budget.seconds) break;
+    // After the budget checks, so a stop that arrives during the last iteration is not
+    // reported as an interruption of a render that was complete anyway.
+    if (it > 0 && callbacks.stop && callbacks.stop->load()) {
+      interrupted = true;
+      break;
+    }
     integrator.render_iteration(scene, it, film);
     film.end_iteration();
     const double t = elapsed();
@@ -49,7 +57,9 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
   }
   integrator.finish(scene, film);
   const double total = elapsed();
-  progress.update(1.0, total > 0 ? double(scene.rays_traced() - rays_before) / total * 1e-6 : 0, "Mrays/s");
+  if (!interrupted)
+    progress.update(1.0, total > 0 ? double(scene.rays_traced() - rays_before) / total * 1e-6 : 0,
+                    "Mrays/s");
   progress.finish();
 
   RenderResult r;
@@ -58,6 +68,7 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
   r.iterations = film.iterations();
   r.rays = scene.rays_traced() - rays_before;
   r.nonfinite = film.nonfinite_count();
+  r.interrupted = interrupted;
   return r;
 }
 

@@ -119,3 +119,19 @@ TEST(Metrics, SsimUsesToneMappedLuminance) {
 
 }  // namespace
 }  // namespace caustica
+
+TEST(Metrics, BlockRelMseSeesBiasNotNoise) {
+  // Zero-mean checkerboard noise cancels within 2x2 blocks; a constant offset does not.
+  caustica::Image ref(4, 4, caustica::Rgb(1.f)), noisy = ref, biased = ref;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) {
+      noisy.at(x, y) = caustica::Rgb((x + y) % 2 ? 1.5f : 0.5f);
+      biased.at(x, y) = caustica::Rgb(1.1f);
+    }
+  EXPECT_NEAR(caustica::block_rel_mse(noisy, ref, 2), 0.0, 1e-12);
+  EXPECT_GT(caustica::rel_mse(noisy, ref), 0.2);
+  EXPECT_NEAR(caustica::block_rel_mse(biased, ref, 2), 0.01 / 1.01, 1e-6);
+  EXPECT_NEAR(caustica::mean_ratio(biased, ref), 1.1, 1e-6);
+  // A partial border block averages only its own pixels.
+  EXPECT_NEAR(caustica::block_rel_mse(biased, ref, 3), 0.01 / 1.01, 1e-6);
+}

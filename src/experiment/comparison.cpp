@@ -20,6 +20,8 @@ ErrorMetrics compute_errors(const Image& image, const Image& reference) {
   e.rel_mse = rel_mse(image, reference, 0.01);
   e.rel_mse_trimmed = rel_mse_trimmed(image, reference, 0.001, 0.01);
   e.ssim = ssim(image, reference);
+  e.block_rel_mse = block_rel_mse(image, reference, 16, 0.01);
+  e.mean_ratio = mean_ratio(image, reference);
   return e;
 }
 
@@ -28,7 +30,9 @@ nlohmann::json to_json(const ErrorMetrics& e) {
           {"rmse", e.rmse},
           {"relmse", e.rel_mse},
           {"relmse_trimmed", e.rel_mse_trimmed},
-          {"ssim", e.ssim}};
+          {"ssim", e.ssim},
+          {"block16_relmse", e.block_rel_mse},
+          {"mean_ratio", e.mean_ratio}};
 }
 
 ComparisonResult run_comparison(const Scene& scene, const Image& reference,

@@ -18,6 +18,8 @@ class Scene;
 
 struct ErrorMetrics {
   double mse = 0, rmse = 0, rel_mse = 0, rel_mse_trimmed = 0, ssim = 0;
+  double block_rel_mse = 0;  // 16x16-pixel blocks: mostly bias
+  double mean_ratio = 0;     // image mean over reference mean
 };
 ErrorMetrics compute_errors(const Image& image, const Image& reference);
 nlohmann::json to_json(const ErrorMetrics& e);

@@ -95,6 +95,36 @@ double rel_mse(const Image& img, const Image& ref, double eps) {
   return sum / double(img.pixel_count());
 }
 
+double block_rel_mse(const Image& img, const Image& ref, int block, double eps) {
+  check_same_size(img, ref, "block_rel_mse");
+  if (block < 1) throw std::invalid_argument("block_rel_mse: block must be >= 1");
+  const int bw = (img.width() + block - 1) / block, bh = (img.height() + block - 1) / block;
+  Image a(bw, bh), b(bw, bh);
+  for (int y = 0; y < img.height(); ++y)
+    for (int x = 0; x < img.width(); ++x) {
+      a.at(x / block, y / block) += img.at(x, y);
+      b.at(x / block, y / block) += ref.at(x, y);
+    }
+  for (int y = 0; y < bh; ++y)
+    for (int x = 0; x < bw; ++x) {
+      const int n = (std::min(img.width(), (x + 1) * block) - x * block) *
+                    (std::min(img.height(), (y + 1) * block) - y * block);
+      a.at(x, y) *= 1.f / float(n);
+      b.at(x, y) *= 1.f / float(n);
+    }
+  return rel_mse(a, b, eps);
+}
+
+double mean_ratio(const Image& img, const Image& ref) {
+  check_same_size(img, ref, "mean_ratio");
+  double s_img = 0, s_ref = 0;
+  for (size_t i = 0; i < img.pixel_count(); ++i) {
+    s_img += img[i].average();
+    s_ref += ref[i].average();
+  }
+  return s_ref > 0 ? s_img / s_ref : 0.0;
+}
+
 double rel_mse_trimmed(const Image& img, const Image& ref, double trim_fraction, double eps) {
   check_same_size(img, ref, "rel_mse_trimmed");
   if (!(trim_fraction >= 0 && trim_fraction < 1))

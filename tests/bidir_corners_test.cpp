@@ -15,7 +15,7 @@
 #include "io/scene_builder.h"
 #include "lights/lights.h"
 #include "materials/materials.h"
-#include "scene/texture.h"
+#include "geometry/texture.h"
 #include "test_scenes.h"
 
 using namespace caustica;

@@ -21,7 +21,7 @@
 #include "materials/material.h"
 #include "materials/materials.h"
 #include "scene/scene.h"
-#include "scene/texture.h"
+#include "geometry/texture.h"
 
 using namespace caustica;
 using namespace caustica::bidir;

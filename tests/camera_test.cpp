@@ -1,4 +1,4 @@
-#include "scene/camera.h"
+#include "geometry/camera.h"
 
 #include <gtest/gtest.h>
 

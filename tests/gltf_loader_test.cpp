@@ -10,7 +10,7 @@
 
 #include "lights/light.h"
 #include "pbrt_test_util.h"
-#include "scene/interaction.h"
+#include "geometry/interaction.h"
 
 namespace caustica {
 namespace {

@@ -17,7 +17,7 @@
 #include "core/warp.h"
 #include "materials/fresnel.h"
 #include "materials/microfacet.h"
-#include "scene/interaction.h"
+#include "geometry/interaction.h"
 
 namespace caustica {
 namespace {

@@ -10,7 +10,7 @@
 #include "io/pbrt/color.h"
 #include "lights/light.h"
 #include "pbrt_test_util.h"
-#include "scene/interaction.h"
+#include "geometry/interaction.h"
 #include "test_scenes.h"
 
 namespace caustica {

@@ -2,7 +2,7 @@
 // density |f| / integral |f|, keeps the box of radius 1/2 bit-identical to the uniform jitter,
 // and renders an edge as the step convolved with the filter, through camera samples (pt),
 // splats (lt) and their MIS combination (bpt) alike. Also: the pbrt loader reads PixelFilter.
-#include "render/pixel_filter.h"
+#include "film/pixel_filter.h"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +19,7 @@
 #include "lights/lights.h"
 #include "materials/materials.h"
 #include "pbrt_test_util.h"
-#include "scene/texture.h"
+#include "geometry/texture.h"
 #include "test_scenes.h"
 
 namespace caustica {

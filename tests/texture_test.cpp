@@ -1,5 +1,5 @@
 // Texture lookups: pbrt-v4 conventions for image textures and the 2D checkerboard.
-#include "scene/texture.h"
+#include "geometry/texture.h"
 
 #include <gtest/gtest.h>
 

@@ -7,7 +7,7 @@
 
 #include "image/metrics.h"
 #include "integrators/registry.h"
-#include "render/film.h"
+#include "film/film.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 

@@ -3,8 +3,8 @@
 #include "lights/light.h"
 #include "lights/light_sampler.h"
 #include "materials/material.h"
-#include "render/film.h"
-#include "render/tiles.h"
+#include "film/film.h"
+#include "film/tiles.h"
 #include "scene/scene.h"
 
 namespace caustica {

@@ -6,7 +6,7 @@
 #include "core/rgb.h"
 #include "core/rng.h"
 #include "integrators/integrator.h"
-#include "render/pixel_filter.h"
+#include "film/pixel_filter.h"
 
 namespace caustica {
 

@@ -7,7 +7,7 @@
 
 #include "core/transform.h"
 #include "lights/light.h"
-#include "scene/shapes.h"
+#include "geometry/shapes.h"
 
 namespace caustica {
 

@@ -7,7 +7,7 @@
 
 #include "core/arena.h"
 #include "materials/bsdf.h"
-#include "scene/interaction.h"
+#include "geometry/interaction.h"
 
 namespace caustica {
 

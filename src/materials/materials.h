@@ -10,7 +10,7 @@
 #include <string_view>
 
 #include "materials/material.h"
-#include "scene/texture.h"
+#include "geometry/texture.h"
 
 namespace caustica {
 

@@ -2,7 +2,7 @@
 #pragma once
 
 #include "materials/microfacet.h"
-#include "scene/texture.h"
+#include "geometry/texture.h"
 
 namespace caustica {
 

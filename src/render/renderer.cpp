@@ -5,7 +5,7 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "render/film.h"
+#include "film/film.h"
 #include "render/progress.h"
 #include "scene/scene.h"
 

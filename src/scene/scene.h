@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "core/vec.h"
-#include "scene/camera.h"
-#include "scene/interaction.h"
-#include "scene/shapes.h"
+#include "geometry/camera.h"
+#include "geometry/interaction.h"
+#include "geometry/shapes.h"
 
 namespace caustica {
 

@@ -21,9 +21,9 @@
 #include "lights/light.h"
 #include "lights/light_sampler.h"
 #include "materials/material.h"
-#include "render/film.h"
-#include "render/pixel_filter.h"
-#include "render/tiles.h"
+#include "film/film.h"
+#include "film/pixel_filter.h"
+#include "film/tiles.h"
 #include "scene/scene.h"
 
 namespace caustica {

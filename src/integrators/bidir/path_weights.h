@@ -8,7 +8,7 @@
 
 #include "core/arena.h"
 #include "integrators/bidir/bidir_integrator.h"
-#include "scene/interaction.h"
+#include "geometry/interaction.h"
 
 namespace caustica {
 class Scene;

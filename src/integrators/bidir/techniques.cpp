@@ -1,7 +1,7 @@
 #include "integrators/bidir/techniques.h"
 
 #include "lights/light.h"
-#include "scene/camera.h"
+#include "geometry/camera.h"
 
 namespace caustica::bidir {
 

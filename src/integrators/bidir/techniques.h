@@ -7,7 +7,7 @@
 #include "core/vec.h"
 #include "integrators/bidir/mis.h"
 #include "materials/bsdf.h"
-#include "scene/interaction.h"
+#include "geometry/interaction.h"
 
 namespace caustica {
 class Camera;

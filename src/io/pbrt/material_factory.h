@@ -21,7 +21,7 @@
 #include "io/pbrt/parameters.h"
 #include "io/pbrt/spectrum_param.h"
 #include "materials/material.h"
-#include "scene/texture.h"
+#include "geometry/texture.h"
 
 namespace caustica::pbrt {
 

@@ -9,7 +9,7 @@
 
 #include "io/pbrt/context.h"
 #include "io/pbrt/parameters.h"
-#include "scene/shapes.h"
+#include "geometry/shapes.h"
 
 namespace caustica::pbrt {
 

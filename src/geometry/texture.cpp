@@ -1,4 +1,4 @@
-#include "scene/texture.h"
+#include "geometry/texture.h"
 
 #include <algorithm>
 #include <cmath>

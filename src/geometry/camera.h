@@ -17,7 +17,7 @@
 
 #include "core/transform.h"
 #include "core/vec.h"
-#include "scene/pixel_filter_params.h"
+#include "geometry/pixel_filter_params.h"
 
 namespace caustica {
 

@@ -1,4 +1,4 @@
-#include "scene/shapes.h"
+#include "geometry/shapes.h"
 
 namespace caustica {
 

@@ -1,4 +1,4 @@
-#include "render/pixel_filter.h"
+#include "film/pixel_filter.h"
 
 #include <stdexcept>
 #include <string>

@@ -1,4 +1,4 @@
-#include "scene/pixel_filter_params.h"
+#include "geometry/pixel_filter_params.h"
 
 namespace caustica {
 

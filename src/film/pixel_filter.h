@@ -28,7 +28,7 @@
 
 #include "core/distribution.h"
 #include "core/vec.h"
-#include "scene/pixel_filter_params.h"
+#include "geometry/pixel_filter_params.h"
 
 namespace caustica {
 

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "core/rng.h"
+#include "geometry/texture.h"
 #include "integrators/bidir/hash_grid.h"
 #include "integrators/bidir/light_path_assignment.h"
 #include "integrators/bidir/mis.h"
@@ -15,7 +16,6 @@
 #include "io/scene_builder.h"
 #include "lights/lights.h"
 #include "materials/materials.h"
-#include "geometry/texture.h"
 #include "test_scenes.h"
 
 using namespace caustica;
@@ -113,7 +113,7 @@ std::unique_ptr<Scene> floor_under_point_light(bool far_sphere) {
 
 TEST(BidirExactPositions, FarAwayObjectDoesNotChangeMerging) {
   IntegratorSettings s;
-  s.radius = 0.01f;
+  s.bidir.radius = 0.01f;
   s.max_depth = 3;
   for (const char* name : {"bpm", "vcm", "ppm"}) {
     const Image near_only = render_with(*floor_under_point_light(false), name, 2, s).image;
@@ -155,8 +155,8 @@ TEST(BidirShadingNormals, MergingAgreesWithPathTracing) {
   auto scene = floor_with_tilted_normals();
   IntegratorSettings s;
   s.max_depth = 3;
-  s.radius = 0.05f;  // the floor is flat: no curvature bias, only the light's gradient
-  s.light_paths = 16384;
+  s.bidir.radius = 0.05f;  // the floor is flat: no curvature bias, only the light's gradient
+  s.bidir.light_paths = 16384;
   auto mean_of = [&](const char* name, int spp) {
     return over_seeds(4, [&](uint64_t seed) {
       s.seed = seed;
@@ -285,8 +285,8 @@ TEST(BidirLightPathAssignment, FewerLightPathsThanPixelsStayUnbiased) {
   auto scene = make_furnace_scene(p, 24, 24);
   IntegratorSettings s;
   s.max_depth = 200;
-  s.radius = 0.05f;
-  s.light_paths = 24 * 24 / 3;
+  s.bidir.radius = 0.05f;
+  s.bidir.light_paths = 24 * 24 / 3;
   for (const char* name : {"bpt", "vcm"}) {
     const auto [m, se] = over_seeds(6, [&](uint64_t seed) {
       s.seed = seed;
@@ -335,8 +335,8 @@ TEST(BidirMergingLeaks, NoLightThroughAZeroThicknessWall) {
   auto scene = two_rooms();
   IntegratorSettings s;
   s.max_depth = 6;
-  s.radius = 0.1f;  // large, so that a leak would be wide and bright
-  s.light_paths = 20000;
+  s.bidir.radius = 0.1f;  // large, so that a leak would be wide and bright
+  s.bidir.light_paths = 20000;
   for (const char* name : {"bpt", "vcm", "bpm", "ppm"}) {
     const Image img = render_with(*scene, name, 2, s).image;
     double max_value = 0;

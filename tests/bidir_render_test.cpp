@@ -53,7 +53,7 @@ TEST(BidirFurnace, UnbiasedIntegratorsMatchAnalyticRadiance) {
   auto scene = make_furnace_scene(p, 24, 24);
   IntegratorSettings s;
   s.max_depth = 200;
-  s.radius = 0.05f;  // the furnace sphere has radius 1
+  s.bidir.radius = 0.05f;  // the furnace sphere has radius 1
   for (const char* name : {"lt", "bpt", "vcm", "bpm"}) {
     const RunStats st = stats_over_seeds(*scene, name, 8, s, 6);
     std::printf("%s furnace mean %.5f se %.5f\n", name, st.mean, st.standard_error);
@@ -75,10 +75,10 @@ TEST(BidirFurnace, ProgressivePhotonMappingWithinShrinkingBiasBound) {
   auto scene = make_furnace_scene(p, 24, 24);
   IntegratorSettings s;
   s.max_depth = 200;
-  s.radius = 0.1f;
+  s.bidir.radius = 0.1f;
   const int spp = 8;
   const RunStats st = stats_over_seeds(*scene, "ppm", spp, s, 6);
-  const double shrink = std::pow(double(spp), s.radius_alpha - 1.0);  // (r_i / r_1)^2
+  const double shrink = std::pow(double(spp), s.bidir.radius_alpha - 1.0);  // (r_i / r_1)^2
   EXPECT_NEAR(st.mean, p.expected_radiance(),
               3 * st.standard_error + 0.01 * shrink * p.expected_radiance())
       << "mean " << st.mean << " se " << st.standard_error;
@@ -117,11 +117,11 @@ TEST_P(BidirAgreement, MatchesPathTracer) {
   auto scene = make_builtin_scene(scene_name, 32, 32);
   IntegratorSettings s;
   s.max_depth = 5;
-  s.radius = 0.01f;
+  s.bidir.radius = 0.01f;
   int spp = 32;
   if (integrator == "ppm") {  // a consistent estimator: enough photons for its noise to be small
-    s.radius = 0.03f;
-    s.light_paths = 8192;
+    s.bidir.radius = 0.03f;
+    s.bidir.light_paths = 8192;
   }
   const int spp_pt = 128;
   auto render_seed = [&](const std::string& name, int n, uint64_t seed) {
@@ -159,7 +159,7 @@ INSTANTIATE_TEST_SUITE_P(Bidir, BidirAgreement,
 TEST(BidirDeterminism, BitIdenticalForOneAndTwoThreads) {
   auto scene = make_builtin_scene("cornell-glass", 40, 40);
   IntegratorSettings s;
-  s.light_paths = 3000;  // not a multiple of the chunk size
+  s.bidir.light_paths = 3000;  // not a multiple of the chunk size
   for (const char* name : {"lt", "bpt", "ppm", "vcm"}) {
     const auto a = render_with(*scene, name, 3, s, 1);
     const auto b = render_with(*scene, name, 3, s, 2);
@@ -179,7 +179,7 @@ TEST(BidirTechniques, ImagesSumToTheFinalImage) {
     std::filesystem::remove_all(dir);
     IntegratorSettings s;
     s.max_depth = 6;
-    s.techniques_dir = dir.string();
+    s.bidir.techniques_dir = dir.string();
     const auto r = render_with(*scene, name, 3, s);
     Image sum(r.image.width(), r.image.height());
     int files = 0;

@@ -13,13 +13,13 @@
 #include <vector>
 
 #include "core/rng.h"
+#include "geometry/texture.h"
 #include "integrators/path_tracer.h"
 #include "io/builtin_scenes.h"
 #include "io/scene_builder.h"
 #include "lights/lights.h"
 #include "materials/materials.h"
 #include "pbrt_test_util.h"
-#include "geometry/texture.h"
 #include "test_scenes.h"
 
 namespace caustica {
@@ -345,7 +345,7 @@ Profile render_profile(const Scene& scene, const std::string& integrator, int re
     IntegratorSettings s;
     s.seed = 1000 + k;
     s.max_depth = 1;
-    s.light_paths = 16 * kWidth * kHeight;
+    s.bidir.light_paths = 16 * kWidth * kHeight;
     const RenderResult r = test::render_with(scene, integrator, spp, s);
     EXPECT_EQ(r.nonfinite, 0u);
     for (int y = 0; y < kHeight; ++y)

@@ -30,19 +30,8 @@ struct RenderOptions : SharedOptions {
   int spp = 0;
   std::string outfile = "caustica.exr";
   float exposure = 0;
-  float radius = 0, radius_alpha = 0.75f;
-  std::string techniques_dir;
   bool quiet = false;
 };
-
-// pbrt-v4 integrator names that map onto ours (the scene file's choice, unless overridden).
-std::string map_pbrt_integrator(const std::string& name) {
-  if (name == "path" || name == "volpath") return "pt";
-  if (name == "bdpt") return "bpt";
-  if (name == "sppm") return "ppm";
-  if (name == "lighttracer") return "lt";
-  return name;
-}
 
 std::string iso_time_now() {
   const std::time_t t = std::time(nullptr);
@@ -70,8 +59,8 @@ int run_render(const RenderOptions& o, const CheckedOptions& checks) {
       print_error("--outfile: " + problem);
       return 2;
     }
-    if (!o.techniques_dir.empty())
-      if (std::string problem = output_dir_problem(o.techniques_dir); !problem.empty()) {
+    if (!o.bidir.techniques_dir.empty())
+      if (std::string problem = output_dir_problem(o.bidir.techniques_dir); !problem.empty()) {
         print_error("--techniques: " + problem);
         return 2;
       }
@@ -82,16 +71,11 @@ int run_render(const RenderOptions& o, const CheckedOptions& checks) {
   if (int rc = load_configured_scene(setup, &scene, &settings, &load_seconds)) return rc;
 
   std::string integrator_name = o.integrator;
-  if (integrator_name.empty()) {
-    const std::string from_scene = map_pbrt_integrator(scene->settings().integrator);
+  if (integrator_name.empty()) {  // the scene file's (the loader maps pbrt-v4's names), else pt
     integrator_name = "pt";
     for (const auto& n : integrator_names())
-      if (n == from_scene) integrator_name = n;
+      if (n == scene->settings().integrator) integrator_name = n;
   }
-  settings.light_paths = o.light_paths;
-  settings.radius = o.radius;
-  settings.radius_alpha = o.radius_alpha;
-  settings.techniques_dir = o.techniques_dir;
   auto integrator = make_integrator(integrator_name, settings);
 
   RenderBudget budget;
@@ -175,17 +159,6 @@ Runner add_render_command(CLI::App& app) {
                   "its folder must exist and be writable");
   checks->number("--exposure", &opts->exposure, -64, 64, false,
                  "PNG exposure in stops, -64..64 (EXR is never tone mapped)");
-  checks->integer(
-      "--light-paths", &opts->light_paths, uint64_t(1), kMaxLightPaths,
-      "Bidirectional: light subpaths per iteration (default: pixel count); at most 2^31-2, as the "
-      "integrators index paths with 32 bits, and at most what memory holds at 40 bytes per path");
-  checks->number("--radius", &opts->radius, 0, 1e12, true,
-                 "Photon mapping / VCM: initial merge radius, positive, at most 1e12 so that "
-                 "pi r^2 times the light paths stays a finite float (default: from scene size)");
-  checks->number("--radius-alpha", &opts->radius_alpha, 0, 1, true,
-                 "Photon mapping / VCM: radius reduction alpha in (0, 1] (default 0.75)");
-  cmd->add_option("--techniques", opts->techniques_dir,
-                  "Bidirectional: write one weighted image per technique to DIR");
   cmd->add_flag("--quiet,-q", opts->quiet, "No progress bar or summary");
   return [opts, checks] { return run_render(*opts, *checks); };
 }

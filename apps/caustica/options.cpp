@@ -155,6 +155,16 @@ CLI::Option* CheckedOptions::choice(const std::string& flags, std::string* out,
   });
 }
 
+CLI::Option* CheckedOptions::text(const std::string& flags, std::string* out,
+                                  const std::string& help) {
+  const std::string name = first_flag(flags);
+  return add(flags, "TEXT", help, [=](const std::string& t) {
+    if (t.empty()) return name + " must not be empty";
+    *out = t;
+    return std::string();
+  });
+}
+
 bool CheckedOptions::check() const {
   for (const Entry& e : entries_) {
     if (e.option->count() == 0) continue;

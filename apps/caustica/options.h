@@ -44,6 +44,9 @@ class CheckedOptions {
   CLI::Option* choice(const std::string& flags, std::string* out, std::vector<std::string> valid,
                       const std::string& help);
 
+  // Any non-empty text (a path, a name checked later).
+  CLI::Option* text(const std::string& flags, std::string* out, const std::string& help);
+
   // Parses every option that was given; on the first bad one prints one line and returns false.
   bool check() const;
 

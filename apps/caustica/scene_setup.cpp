@@ -26,6 +26,17 @@ CLI::Option* add_shared_options(CheckedOptions& o, SharedOptions* s, const std::
            "family)");
   o.integer("--camera", &s->camera, 0, std::numeric_limits<int>::max(),
             "glTF: which camera to use, in node order (default: the first)");
+  o.integer(
+      "--light-paths", &s->bidir.light_paths, uint64_t(1), kMaxLightPaths,
+      "Bidirectional: light subpaths per iteration (default: pixel count); at most 2^31-2, as the "
+      "integrators index paths with 32 bits, and at most what memory holds at 40 bytes per path");
+  o.number("--radius", &s->bidir.radius, 0, 1e12, true,
+           "Photon mapping / VCM: initial merge radius, positive, at most 1e12 so that pi r^2 "
+           "times the light paths stays a finite float (default: from scene size)");
+  o.number("--radius-alpha", &s->bidir.radius_alpha, 0, 1, true,
+           "Photon mapping / VCM: radius reduction alpha in (0, 1] (default 0.75)");
+  o.text("--techniques", &s->bidir.techniques_dir,
+         "Bidirectional: write one weighted image per technique to DIR");
   return time;
 }
 
@@ -34,7 +45,7 @@ namespace {
 int check_before_loading(const SceneSetup& s) {
   std::string problem = scene_path_problem(s.scene);
   if (problem.empty() && s.width > 0)
-    problem = film_memory_problem(s.width, s.height, s.light_paths);
+    problem = film_memory_problem(s.width, s.height, s.bidir.light_paths);
   if (problem.empty()) return 0;
   print_error(problem);
   return 2;
@@ -61,8 +72,8 @@ int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene,
     *load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (s.width > 0) (*scene)->override_resolution(s.width, s.height);
   // The scene file's own resolution has not been checked yet.
-  const std::string problem =
-      film_memory_problem((*scene)->camera().width(), (*scene)->camera().height(), s.light_paths);
+  const std::string problem = film_memory_problem((*scene)->camera().width(),
+                                                  (*scene)->camera().height(), s.bidir.light_paths);
   if (!problem.empty()) {
     print_error(problem);
     return 2;
@@ -70,8 +81,9 @@ int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene,
   const int scene_depth = (*scene)->settings().max_depth;
   settings->max_depth = s.max_depth >= 0 ? s.max_depth : (scene_depth > 0 ? scene_depth : 10);
   settings->seed = s.seed;
-  settings->mis = s.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
-  settings->mis_from_user = !s.mis.empty();
+  if (!s.mis.empty())
+    settings->mis = s.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
+  settings->bidir = s.bidir;
   return 0;
 }
 

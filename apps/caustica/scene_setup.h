@@ -19,8 +19,10 @@ struct SceneSetup {
   int width = 0, height = 0;  // --resolution; 0: the scene's
   int max_depth = -1;         // -1: the scene's, else 10
   uint64_t seed = 0;
-  std::string mis;           // "", "balance" or "power"; empty: each integrator's default
-  uint64_t light_paths = 0;  // --light-paths, for the memory estimate; 0: one per pixel
+  std::string mis;  // "", "balance" or "power"; empty: each integrator's default
+  // Integrator options (every rendering subcommand takes them; integrators that do not use one
+  // ignore it).
+  BidirSettings bidir;  // --light-paths, --radius, --radius-alpha, --techniques
 };
 
 // The options render, reference and compare share, with the ranges they all obey.
@@ -34,7 +36,8 @@ struct SharedOptions : SceneSetup {
 constexpr double kMaxSeconds = 30 * 24 * 3600;
 
 // Registers --time (with the command's help text; returned so it can be made required),
-// --threads, --max-depth, --seed, --resolution, --mis and --camera.
+// --threads, --max-depth, --seed, --resolution, --mis, --camera and the integrator options
+// --light-paths, --radius, --radius-alpha and --techniques.
 CLI::Option* add_shared_options(CheckedOptions& options, SharedOptions* shared,
                                 const std::string& time_help);
 

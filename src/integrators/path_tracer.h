@@ -1,29 +1,30 @@
 // `pt`: unidirectional path tracing with next event estimation and BSDF sampling combined by
 // multiple importance sampling (Veach 1997, ch. 9), Russian roulette, delta BSDFs and lights.
+// A camera-path integrator: the seam (camera_path.h) owns pixels, streams and the film.
 #pragma once
 
-#include "core/arena.h"
-#include "core/rgb.h"
-#include "core/rng.h"
-#include "integrators/integrator.h"
-#include "film/pixel_filter.h"
+#include "integrators/camera_path.h"
 
 namespace caustica {
 
-class PathTracer final : public Integrator {
+class PathTracer final : public CameraPathIntegrator {
  public:
-  explicit PathTracer(const IntegratorSettings& settings) : settings_(settings) {}
+  explicit PathTracer(const IntegratorSettings& settings)
+      : CameraPathIntegrator(settings.seed), settings_(settings) {}
   const char* name() const override { return "pt"; }
-  void prepare(const Scene& scene, Film& film) override;
-  void render_iteration(const Scene& scene, uint32_t iteration, Film& film) override;
 
   // Radiance arriving along a camera ray; exposed for tests.
-  Rgb radiance(const Scene& scene, const struct Ray& ray, Pcg32& rng, ScratchArena& arena) const;
+  Rgb radiance(const Scene& scene, const Ray& ray, Pcg32& rng, ScratchArena& arena) const;
+
+ protected:
+  Rgb estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng, ScratchArena& arena,
+               uint64_t*) const override {
+    return radiance(scene, sample.ray, rng, arena);
+  }
 
  private:
   float mis_weight(float pdf_a, float pdf_b) const;
   IntegratorSettings settings_;
-  PixelFilter filter_;  // the scene camera's, set by prepare()
 };
 
 }  // namespace caustica

@@ -12,6 +12,7 @@ namespace caustica {
 // Names accepted by make_integrator, in the order the README documents them.
 std::vector<std::string> integrator_names();
 // Returns nullptr for an unknown name.
-std::unique_ptr<Integrator> make_integrator(const std::string& name, const IntegratorSettings& settings);
+std::unique_ptr<Integrator> make_integrator(const std::string& name,
+                                            const IntegratorSettings& settings);
 
 }  // namespace caustica

@@ -13,17 +13,18 @@
 
 #include "core/arena.h"
 #include "core/rng.h"
+#include "film/film.h"
+#include "film/pixel_filter.h"
 #include "image/image_io.h"
 #include "integrators/bidir/hash_grid.h"
 #include "integrators/bidir/light_path_assignment.h"
 #include "integrators/bidir/light_vertex.h"
 #include "integrators/bidir/techniques.h"
+#include "integrators/camera_path.h"
+#include "integrators/path_vertex.h"
 #include "lights/light.h"
 #include "lights/light_sampler.h"
 #include "materials/material.h"
-#include "film/film.h"
-#include "film/pixel_filter.h"
-#include "film/tiles.h"
 #include "scene/scene.h"
 
 namespace caustica {
@@ -173,14 +174,16 @@ struct PixelAccumulator {
   size_t pixel = 0;
   uint64_t nonfinite = 0;
   float filter_weight = 1;  // the camera sample's pixel-filter weight (pixel_filter.h)
+  // sum is the estimate before the filter weight (the seam applies it); technique images get
+  // each value already weighted, so that they add up to the image.
   void add(bool merge, int s, int t, Rgb value) {
     if (!value.is_finite()) {
       ++nonfinite;
       return;
     }
-    value *= filter_weight;
     sum += value;
-    if (techniques) techniques->add(TechniqueImages::key(merge, s, t), pixel, value);
+    if (techniques)
+      techniques->add(TechniqueImages::key(merge, s, t), pixel, value * filter_weight);
   }
 };
 
@@ -194,23 +197,29 @@ Ray ray_leaving_light(const LightLeSample& le, const Light& light) {
   return {le.p, le.dir, kInfinity};
 }
 
-class BidirIntegrator final : public Integrator {
+class BidirIntegrator final : public CameraPathIntegrator {
  public:
   BidirIntegrator(BidirAlgorithm algorithm, const IntegratorSettings& settings)
-      : algorithm_(algorithm), tech_(techniques_of(algorithm)), settings_(settings) {
-    heuristic_ = settings.mis_from_user ? settings.mis : MisHeuristic::Balance;
+      : CameraPathIntegrator(hash_combine(settings.seed, 0xca3e7aull)),
+        algorithm_(algorithm),
+        tech_(techniques_of(algorithm)),
+        settings_(settings) {
+    heuristic_ = settings.mis_or(MisHeuristic::Balance);
   }
   const char* name() const override { return name_of(algorithm_); }
 
   void prepare(const Scene& scene, Film& film) override {
+    CameraPathIntegrator::prepare(scene, film);
     filter_ = PixelFilter(scene.camera().pixel_filter());
     Vec3 center;
     float scene_radius;
     scene.bounds().bounding_sphere(&center, &scene_radius);
-    base_radius_ = settings_.radius > 0 ? settings_.radius
-                                        : kDefaultRadiusFactor * std::max(scene_radius, 1e-3f);
-    light_paths_ = settings_.light_paths > 0 ? settings_.light_paths : film.pixel_count();
-    if (!settings_.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
+    base_radius_ = settings_.bidir.radius > 0
+                       ? settings_.bidir.radius
+                       : kDefaultRadiusFactor * std::max(scene_radius, 1e-3f);
+    light_paths_ =
+        settings_.bidir.light_paths > 0 ? settings_.bidir.light_paths : film.pixel_count();
+    if (!settings_.bidir.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
     const uint64_t chunks = (light_paths_ + kChunkPaths - 1) / kChunkPaths;
     chunks_.resize(chunks);
   }
@@ -221,7 +230,7 @@ class BidirIntegrator final : public Integrator {
     it.index = iteration;
     // r_i = r_1 * i^((alpha - 1) / 2), i 1-based (Knaus & Zwicker 2011; Georgiev et al. 2012).
     it.radius = std::max(
-        base_radius_ * std::pow(float(iteration + 1), 0.5f * (settings_.radius_alpha - 1.f)),
+        base_radius_ * std::pow(float(iteration + 1), 0.5f * (settings_.bidir.radius_alpha - 1.f)),
         1e-7f);
     it.rules = MisRules(heuristic_, tech_.connect || tech_.light_to_camera, tech_.merge,
                         float(light_paths_), it.radius);
@@ -231,7 +240,8 @@ class BidirIntegrator final : public Integrator {
 
     trace_light_paths(scene, it, film);
     if (tech_.merge) grid_.build(vertices_, it.radius);
-    trace_camera_paths(scene, it, film);
+    current_ = it;
+    trace_camera_paths(scene, iteration, film);
 
     ++iterations_;
     last_radius_ = it.radius;
@@ -242,7 +252,7 @@ class BidirIntegrator final : public Integrator {
 
   void finish(const Scene&, Film& film) override {
     if (techniques_.enabled())
-      technique_files_ = techniques_.write(settings_.techniques_dir, film.iterations());
+      technique_files_ = techniques_.write(settings_.bidir.techniques_dir, film.iterations());
   }
 
   void report(nlohmann::json& stats) const override {
@@ -256,7 +266,7 @@ class BidirIntegrator final : public Integrator {
     b["hash_grid_bytes"] = grid_.memory_bytes();
     b["radius_initial"] = base_radius_;
     b["radius_last"] = last_radius_;
-    b["radius_alpha"] = settings_.radius_alpha;
+    b["radius_alpha"] = settings_.bidir.radius_alpha;
     b["ms_per_iteration"] = iterations_ ? 1e3 * seconds_total_ / iterations_ : 0.0;
     if (!technique_files_.empty()) b["technique_images"] = technique_files_;
     stats["bidir"] = b;
@@ -423,36 +433,25 @@ class BidirIntegrator final : public Integrator {
   }
 
   // ---- camera subpaths ----------------------------------------------------------------------
-  void trace_camera_paths(const Scene& scene, const Iteration& it, Film& film) {
-    std::atomic<uint64_t> nonfinite{0};
-    parallel_for_tiles(film.width(), film.height(), [&](const Tile& tile, ScratchArena& arena) {
-      uint64_t bad = 0;
-      for (int y = tile.y0; y < tile.y1; ++y)
-        for (int x = tile.x0; x < tile.x1; ++x) {
-          arena.reset();
-          PixelAccumulator acc;
-          acc.pixel = size_t(y) * film.width() + x;
-          if (techniques_.enabled()) acc.techniques = &techniques_;
-          camera_path(scene, it, x, y, acc, arena);
-          film.add_sample(x, y, acc.sum);
-          bad += acc.nonfinite;
-        }
-      if (bad) nonfinite += bad;
-    });
-    if (nonfinite) film.count_nonfinite(nonfinite);
+  // The seam's per-pixel call: the camera subpath of this iteration (current_).
+  Rgb estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng, ScratchArena& arena,
+               uint64_t* nonfinite) const override {
+    PixelAccumulator acc;
+    acc.pixel = sample.pixel;
+    acc.filter_weight = sample.filter_weight;
+    if (techniques_.enabled()) acc.techniques = const_cast<TechniqueImages*>(&techniques_);
+    camera_path(scene, current_, sample, rng, acc, arena);
+    *nonfinite += acc.nonfinite;
+    return acc.sum;
   }
 
-  void camera_path(const Scene& scene, const Iteration& it, int x, int y, PixelAccumulator& acc,
-                   ScratchArena& arena) const {
+  void camera_path(const Scene& scene, const Iteration& it, const CameraSample& sample, Pcg32& rng,
+                   PixelAccumulator& acc, ScratchArena& arena) const {
     const Camera& camera = scene.camera();
     const LightSampler& lights = scene.light_sampler();
-    const uint64_t pixel = acc.pixel;
-    Pcg32 rng = Pcg32::for_sample(pixel, it.index, hash_combine(settings_.seed, 0xca3e7aull));
-    const CameraFilterSample film_sample = filter_.sample_camera(x, y, rng.next_2d());
-    const Vec2 lens = rng.next_2d();
-    Ray ray = camera.generate_ray(film_sample.raster, lens);
-    acc.filter_weight = film_sample.weight;
-    const float pdf_camera = bidir::camera_pdf_w(camera, ray.o, ray.d, film_sample.pdf);
+    const uint64_t pixel = sample.pixel;
+    Ray ray = sample.ray;
+    const float pdf_camera = bidir::camera_pdf_w(camera, ray.o, ray.d, sample.filter_pdf);
     if (!(pdf_camera > 0)) return;
     MisSums mis = it.rules.camera_start(pdf_camera);
     const int max_depth = settings_.max_depth;
@@ -474,12 +473,10 @@ class BidirIntegrator final : public Integrator {
     for (;;) {
       SurfaceInteraction si;
       if (!scene.intersect(ray, &si)) {
-        for (const Light* light : scene.infinite_lights()) {
-          const Rgb Le = light->radiance_escaped(ray.d);
-          if (Le.is_black()) continue;
-          const float w = emitter_weight(*light, nullptr, mis);
+        for_each_emitter_seen(scene.infinite_lights(), ray, nullptr, [&](const Light& l, Rgb Le) {
+          const float w = emitter_weight(l, nullptr, mis);
           if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w);
-        }
+        });
         break;
       }
       segment += si.t;
@@ -488,13 +485,10 @@ class BidirIntegrator final : public Integrator {
       MisSums at_hit = mis;
       it.rules.hit(at_hit, segment * segment, bidir::geometric_cos(si, si.wo));
 
-      if (si.area_light) {
-        const Rgb Le = si.area_light->radiance(si.p, si.ng, si.uv, si.wo);
-        if (!Le.is_black()) {
-          const float w = emitter_weight(*si.area_light, &si, at_hit);
-          if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w);
-        }
-      }
+      for_each_emitter_seen(scene.infinite_lights(), ray, &si, [&](const Light& l, Rgb Le) {
+        const float w = emitter_weight(l, &si, at_hit);
+        if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w);
+      });
       if (!bsdf.valid()) {
         ray = si.spawn_ray(ray.d);
         continue;
@@ -529,34 +523,21 @@ class BidirIntegrator final : public Integrator {
       if (beta.is_black()) break;
       prev_p = si.p;
       ray = si.spawn_ray(bs->wi);
-      // Russian roulette as pt: throughput with the radiance scaling of refraction removed.
-      const float rr = (beta * eta_scale).max_component();
-      if (rr < 1 && depth > 1) {
-        const float q = std::max(0.f, 1 - rr);
-        if (rng.next_float() < q) break;
-        beta = beta / (1 - q);
-      }
+      if (!survives_russian_roulette(beta, eta_scale, depth, rng)) break;
     }
   }
 
   void next_event(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
                   const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth, Pcg32& rng,
                   PixelAccumulator& acc) const {
-    const LightSampler& lights = scene.light_sampler();
-    float pmf;
-    const Light* light = lights.sample(rng.next_float(), &pmf);
+    const float u_light = rng.next_float();
     const Vec2 u = rng.next_2d();
-    if (!light || !(pmf > 0)) return;
-    const auto ls = light->sample_li(si.p, u);
-    if (!ls || !(ls->pdf_w > 0) || ls->radiance.is_black()) return;
-    const Rgb f = bsdf.f(si.wo, ls->wi, TransportMode::Radiance) * bsdf.abs_cos(ls->wi);
-    if (f.is_black()) return;
-    const float w = bidir::weight_next_event(it.rules, *light, pmf, *ls, si, bsdf, mis);
-    const Rgb value = beta * f * ls->radiance * (w / (pmf * ls->pdf_w));
+    const auto d = sample_direct_light(scene, si, bsdf, u_light, u);
+    if (!d) return;
+    const float w = bidir::weight_next_event(it.rules, *d->light, d->pmf, d->ls, si, bsdf, mis);
+    const Rgb value = beta * d->f * d->ls.radiance * (w / (d->pmf * d->ls.pdf_w));
     if (value.is_black()) return;
-    const Ray shadow =
-        std::isinf(ls->distance) ? si.spawn_ray(ls->wi) : si.spawn_ray_to(ls->p_light);
-    if (scene.occluded(shadow)) return;
+    if (scene.occluded(d->shadow)) return;
     acc.add(false, 1, depth + 1, value);
   }
 
@@ -651,7 +632,8 @@ class BidirIntegrator final : public Integrator {
   Techniques tech_;
   IntegratorSettings settings_;
   MisHeuristic heuristic_;
-  PixelFilter filter_;  // the scene camera's, set by prepare()
+  PixelFilter filter_;  // the scene camera's, set by prepare(): light-tracing splats
+  Iteration current_;   // this iteration's constants, for estimate()
   float base_radius_ = 0, last_radius_ = 0;
   uint64_t light_paths_ = 0;
 

@@ -12,7 +12,7 @@
 //   bpm  merging at every camera vertex, MIS over merges (no connections).
 //   vcm  bpt + bpm with MIS over all (merge acceptance p_acc = pi r^2 per light path).
 //
-// Per iteration: N light subpaths (settings.light_paths, 0 = one per pixel) are traced in fixed
+// Per iteration: N light subpaths (settings.bidir.light_paths, 0 = one per pixel) are traced in fixed
 // chunks of 1024, their non-delta vertices stored in 40 bytes each (light_vertex.h) and
 // concatenated in chunk order; light-tracing splats are recorded per chunk and applied in chunk
 // order; a hash grid over the vertices serves merging; then one camera subpath per pixel.
@@ -20,7 +20,7 @@
 // any thread count.
 //
 // Settings: max_depth (scattering vertices, pbrt-v4); mis (the family defaults to balance: the
-// power heuristic is used only when settings.mis_from_user says --mis power was asked for);
+// power heuristic is used only when settings.mis says --mis power was asked for);
 // radius (initial merge radius r_1, default 0.003 * the scene's bounding-sphere radius, as
 // SmallVCM) shrinking as r_i = r_1 i^((alpha - 1) / 2) for the 1-based iteration i;
 // radius_alpha (0.75); techniques_dir (one EXR per technique; their sum is the image).

@@ -1,0 +1,74 @@
+// What every camera path does at its vertices, written once for pt, the bidirectional camera
+// subpath and the integrators to come: the emitters a ray sees, the density with which next
+// event estimation would have chosen them (emitter MIS), a light sample for next event
+// estimation, and Russian roulette. Each integrator keeps its own weights; these give it the
+// samples and pdfs.
+#pragma once
+
+#include <algorithm>
+#include <optional>
+#include <vector>
+
+#include "core/rgb.h"
+#include "core/rng.h"
+#include "geometry/interaction.h"
+#include "lights/light.h"
+#include "materials/bsdf.h"
+
+namespace caustica {
+
+class Scene;
+class LightSampler;
+
+// The emitters a camera ray reaches: with hit == nullptr (the ray escaped) every infinite light
+// along ray.d, else the area light of the hit primitive. fn(const Light&, Rgb Le) for each
+// non-black one.
+template <typename Fn>
+void for_each_emitter_seen(const std::vector<const Light*>& infinite_lights, const Ray& ray,
+                           const SurfaceInteraction* hit, Fn&& fn) {
+  if (!hit) {
+    for (const Light* light : infinite_lights) {
+      const Rgb Le = light->radiance_escaped(ray.d);
+      if (!Le.is_black()) fn(*light, Le);
+    }
+  } else if (hit->area_light) {
+    const Rgb Le = hit->area_light->radiance(hit->p, hit->ng, hit->uv, hit->wo);
+    if (!Le.is_black()) fn(*hit->area_light, Le);
+  }
+}
+
+// Solid-angle density at prev_p with which next event estimation (the one light distribution
+// times the light's pdf_li) picks the emitter seen along dir: at `hit`, or, with hit ==
+// nullptr, the infinite light in that direction.
+float next_event_pdf(const LightSampler& lights, const Light& light, Vec3 prev_p, Vec3 dir,
+                     const SurfaceInteraction* hit);
+
+// A light sample for next event estimation from si: the light picked by the power-based light
+// distribution (pmf), the point sampled on it (ls), the BSDF value times |cos| toward it (f) and
+// the shadow ray to test. Nothing if any factor vanishes; no ray is traced. u_light picks the
+// light and u the point (the caller draws them, in that order).
+struct DirectLightSample {
+  const Light* light = nullptr;
+  float pmf = 0;
+  LightLiSample ls;
+  Rgb f;
+  Ray shadow;
+};
+std::optional<DirectLightSample> sample_direct_light(const Scene& scene,
+                                                     const SurfaceInteraction& si, const Bsdf& bsdf,
+                                                     float u_light, Vec2 u);
+
+// Russian roulette after `depth` scattering vertices, on the throughput with the radiance
+// scaling of refraction (eta_scale) removed, never before the second vertex. Returns false when
+// the path ends; otherwise beta is divided by the survival probability.
+inline bool survives_russian_roulette(Rgb& beta, float eta_scale, int depth, Pcg32& rng) {
+  const float rr = (beta * eta_scale).max_component();
+  if (rr < 1 && depth > 1) {
+    const float q = std::max(0.f, 1 - rr);
+    if (rng.next_float() < q) return false;
+    beta = beta / (1 - q);
+  }
+  return true;
+}
+
+}  // namespace caustica

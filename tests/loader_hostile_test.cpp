@@ -346,6 +346,17 @@ TEST(GltfHostile, ImageHeaderClaimingMorePixelsThanItsDataIsAnError) {
   EXPECT_TRUE(contains(e, "images[0]: its header claims 16000x16000 pixels, more than its")) << e;
 }
 
+TEST(GltfHostile, ImageBufferViewOutsideItsBufferIsAnError) {
+  // tinygltf hands the image decoder &buffer.data[byteOffset] and byteLength unchecked.
+  json j = triangle_model();
+  j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 4096}, {"byteLength", 100000}});
+  j["images"] = {{{"bufferView", 2}, {"mimeType", "image/png"}}};
+  EXPECT_TRUE(contains(gltf_error(j.dump()),
+                       "images[0]: bufferViews[2] lies outside its buffer "
+                       "(44 bytes)"))
+      << gltf_error(j.dump());
+}
+
 TEST(GltfHostile, TinygltfMessagesAreEscapedAndShort) {
   // tinygltf quotes a whole undecodable data: URI in its message.
   json j = triangle_model();
@@ -469,6 +480,24 @@ TEST(PbrtHostile, NumbersOutsideTheFloatRangeAreErrors) {
   EXPECT_EQ(load_error(with_camera("Material \"diffuse\" \"rgb reflectance\" [ nan 0.5 0.5 ]\n")),
             "test.pbrt:4:40: error: \"rgb reflectance\": \"nan\" is not a finite number in the "
             "range of a 32-bit float");
+}
+
+TEST(PbrtHostile, NonFiniteNumbersInSpectrumFilesAreErrors) {
+  test::TempDir dir;
+  dir.write("bad.spd", "400 1\n500 nan\n");
+  const std::string main =
+      dir.write("main.pbrt", with_camera("LightSource \"point\" \"spectrum I\" \"bad.spd\"\n"));
+  try {
+    load_pbrt(main, collect);
+    FAIL() << "expected an error";
+  } catch (const SceneLoadError& e) {
+    EXPECT_EQ(e.where().line, 4);
+    EXPECT_EQ(e.where().column, 21);
+    EXPECT_TRUE(contains(e.message(),
+                         "expected finite numbers (wavelength, value pairs), got "
+                         "\"nan\""))
+        << e.what();
+  }
 }
 
 TEST(PbrtHostile, EmissionThatOverflowsIsALocatedError) {

@@ -1,6 +1,8 @@
 #include "io/pbrt/spectrum_param.h"
 
 #include <charconv>
+#include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "io/input_file.h"
@@ -29,9 +31,13 @@ std::vector<double> read_spectrum_file(const Param& p, const std::string& path) 
     while (words >> w) {
       double v = 0;
       const auto [ptr, ec] = std::from_chars(w.data(), w.data() + w.size(), v);
-      if (ec != std::errc() || ptr != w.data() + w.size())
+      // As in the scene file itself: "nan", "inf" and numbers beyond the float range are
+      // not spectrum values.
+      if (ec != std::errc() || ptr != w.data() + w.size() || !std::isfinite(v) ||
+          std::abs(v) > std::numeric_limits<float>::max())
         param_error(p, quote_excerpt(path, kPathExcerpt) +
-                           ": expected numbers (wavelength, value pairs), got " + quote_excerpt(w));
+                           ": expected finite numbers (wavelength, value pairs), got " +
+                           quote_excerpt(w));
       values.push_back(v);
     }
   }

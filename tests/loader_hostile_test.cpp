@@ -39,24 +39,43 @@ struct Scope {
   }
   ~Scope() { armed = false; }
 };
-}  // namespace alloc_probe
 
-void* operator new(size_t size) {
-  if (alloc_probe::armed) {
-    alloc_probe::largest = std::max(alloc_probe::largest, size);
-    if (size > alloc_probe::kRefuseAbove) throw std::bad_alloc();
+void* allocate(size_t size) {
+  if (armed) {
+    largest = std::max(largest, size);
+    if (size > kRefuseAbove) return nullptr;
   }
-  if (void* p = std::malloc(size ? size : 1)) return p;
+  return std::malloc(size ? size : 1);
+}
+void* allocate_or_throw(size_t size) {
+  if (void* p = allocate(size)) return p;
   throw std::bad_alloc();
 }
+}  // namespace alloc_probe
+
+// Every non-aligned form is replaced, all on malloc/free, so that whichever pair the library
+// uses (nothrow new with plain delete, sized delete, ...) matches: under ASan, whose runtime
+// supplies the forms left out, a malloc'd block reaching its operator delete is reported as a
+// mismatch. The aligned forms are left alone; they pair among themselves.
+void* operator new(size_t size) { return alloc_probe::allocate_or_throw(size); }
+void* operator new[](size_t size) { return alloc_probe::allocate_or_throw(size); }
+void* operator new(size_t size, const std::nothrow_t&) noexcept {
+  return alloc_probe::allocate(size);
+}
+void* operator new[](size_t size, const std::nothrow_t&) noexcept {
+  return alloc_probe::allocate(size);
+}
 // GCC sees operator new's pointer reach free() once these are inlined and warns; new is
-// malloc here, so they match. (Leaving delete alone would pair malloc with the default
-// operator delete, which ASan reports as a mismatch.)
+// malloc here, so they match.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpragmas"
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, size_t) noexcept { std::free(p); }
+void operator delete[](void* p, size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 #pragma GCC diagnostic pop
 
 namespace caustica {

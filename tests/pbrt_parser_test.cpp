@@ -254,7 +254,9 @@ TEST(PbrtErrors, MissingSceneFile) {
     load_pbrt("/nonexistent/scene.pbrt", test::capture_warning);
     FAIL();
   } catch (const SceneLoadError& e) {
-    EXPECT_STREQ(e.what(), "/nonexistent/scene.pbrt: error: cannot open the scene file");
+    EXPECT_STREQ(e.what(),
+                 "/nonexistent/scene.pbrt: error: cannot open the scene file: No such file or "
+                 "directory");
   }
 }
 

@@ -6,28 +6,43 @@
 
 namespace caustica {
 
+namespace {
+// Lights are chosen in proportion to their power: one infinite or NaN power (radiance times
+// a huge area) would break the distribution for every light.
+void check_power(const Light& light) {
+  if (!light.power().is_finite())
+    throw std::runtime_error("an area light's total power overflows to infinity");
+}
+}  // namespace
+
 void SceneBuilder::add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaEmission* emission) {
-  if (mesh.indices.size() % 3 != 0) throw std::runtime_error("triangle mesh index count is not a multiple of 3");
+  if (mesh.indices.size() % 3 != 0)
+    throw std::runtime_error("triangle mesh index count is not a multiple of 3");
   for (uint32_t i : mesh.indices)
     if (i >= mesh.positions.size()) throw std::runtime_error("triangle mesh index out of range");
   SceneData::MeshEntry entry;
   if (emission && !emission->radiance.is_black()) {
     entry.first_light = uint32_t(data_.lights.size());
-    for (size_t t = 0; t < mesh.triangle_count(); ++t)
-      data_.lights.push_back(make_triangle_area_light(mesh, t, emission->radiance, emission->two_sided));
+    for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+      data_.lights.push_back(
+          make_triangle_area_light(mesh, t, emission->radiance, emission->two_sided));
+      check_power(*data_.lights.back());
+    }
   }
   entry.mesh = std::move(mesh);
   entry.material = std::move(material);
   data_.meshes.push_back(std::move(entry));
 }
 
-void SceneBuilder::add_sphere(const Sphere& sphere, MaterialPtr material, const AreaEmission* emission) {
+void SceneBuilder::add_sphere(const Sphere& sphere, MaterialPtr material,
+                              const AreaEmission* emission) {
   SceneData::SphereEntry entry;
   entry.sphere = sphere;
   entry.material = std::move(material);
   if (emission && !emission->radiance.is_black()) {
     entry.light = uint32_t(data_.lights.size());
     data_.lights.push_back(make_sphere_area_light(sphere, emission->radiance, emission->two_sided));
+    check_power(*data_.lights.back());
   }
   data_.spheres.push_back(std::move(entry));
 }
@@ -36,7 +51,8 @@ void SceneBuilder::add_light(LightPtr light) { data_.lights.push_back(std::move(
 
 std::unique_ptr<Scene> SceneBuilder::build(const std::string& name) {
   if (!has_camera_) throw std::runtime_error("scene has no camera");
-  if (data_.camera.width <= 0 || data_.camera.height <= 0) throw std::runtime_error("scene has an empty film");
+  if (data_.camera.width <= 0 || data_.camera.height <= 0)
+    throw std::runtime_error("scene has an empty film");
   data_.name = name;
   return std::make_unique<Scene>(std::move(data_));
 }

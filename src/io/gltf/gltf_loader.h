@@ -21,13 +21,25 @@
 #include <string>
 
 #include "io/load_error.h"
+#include "io/scene_builder.h"
 #include "scene/scene.h"
 
 namespace caustica {
 
 // camera_index: which glTF camera (in the order of model.cameras) to render from; -1 takes
-// the first camera a node uses, or, without one, a camera that frames the scene.
-// Throws SceneLoadError ("file: error: ...") for files that cannot be read or are invalid.
+// the first camera a node uses, or, without one, a camera that frames the scene; any other
+// index outside the file's cameras is an error.
+// Throws SceneLoadError ("file: error: accessors[3]: ...", naming the JSON element) for files
+// that cannot be read or are invalid. Every count, offset and stride in the file is checked
+// against the bytes really there before anything is allocated for it; images are checked
+// against the pixels their data can hold before they are decoded; nodes must form trees.
 std::unique_ptr<Scene> load_gltf(const std::string& path, WarningSink warn, int camera_index = -1);
+
+// Parses a glTF file held in memory (JSON, or GLB when it starts with "glTF") into
+// `builder` without building the scene and without file access: external buffer and image
+// URIs are errors (data: URIs work). `name` is the file name used in messages. A nonzero
+// `max_triangles` bounds the geometry (for fuzzing). Throws SceneLoadError.
+void parse_gltf_memory(const std::string& bytes, const std::string& name, SceneBuilder& builder,
+                       WarningSink warn, int camera_index = -1, size_t max_triangles = 0);
 
 }  // namespace caustica

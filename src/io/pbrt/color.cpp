@@ -46,7 +46,9 @@ double d65(double l) {
 double planck(double lambda_nm, double kelvin) {
   const double c = 299792458., h = 6.62606957e-34, kb = 1.3806488e-23;
   const double l = lambda_nm * 1e-9;
-  return (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * kelvin)) - 1));
+  // expm1: for hot bodies the exponent is tiny and exp(x) - 1 would round to 0 (a division
+  // by zero, then NaN colours), where expm1(x) = x keeps the Rayleigh-Jeans limit.
+  return (2 * h * c * c) / (std::pow(l, 5) * std::expm1((h * c) / (l * kb * kelvin)));
 }
 
 template <typename F>

@@ -6,8 +6,8 @@ namespace caustica::pbrt {
 
 std::string LoaderContext::resolve(const std::string& name, const SourceLocation& where) const {
   if (!allow_files)
-    throw SceneLoadError(
-        where, "cannot read \"" + name + "\": file access is disabled when parsing from memory");
+    throw SceneLoadError(where, "cannot read " + quote_excerpt(name, kPathExcerpt) +
+                                    ": file access is disabled when parsing from memory");
   namespace fs = std::filesystem;
   const fs::path path(name);
   if (path.is_absolute()) return name;

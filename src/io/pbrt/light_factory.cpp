@@ -8,12 +8,43 @@ namespace caustica::pbrt {
 
 namespace {
 
+// Emission is checked where it is computed: a value that overflowed to infinity would make
+// the light's power, and so the light selection distribution, infinite or NaN at render time.
+// `blame` is the parameter whose factor made it overflow.
+Rgb check_emission(Rgb value, const Param& blame, const char* what) {
+  if (!value.is_finite())
+    param_error(blame, "makes the " + std::string(what) + " overflow to infinity");
+  return value;
+}
+
+// "scale" of a light: a non-negative factor.
+float light_scale(const ParamList& params) {
+  const float scale = params.get_float("scale", 1);
+  if (scale < 0) param_error(*params.find("scale"), "must not be negative");
+  return scale;
+}
+
 // The emitted RGB of a light's spectrum parameter, default the illuminant (white), times
 // "scale".
 Rgb emission(const ParamList& params, const char* name, LoaderContext& ctx) {
   const Param* p = params.find(name, {ParamType::Rgb, ParamType::Spectrum, ParamType::Blackbody});
   const Rgb rgb = p ? spectrum_param_rgb(*p, SpectrumKind::Illuminant, ctx) : Rgb(1.f);
-  return rgb * params.get_float("scale", 1);
+  if (p) check_emission(rgb, *p, "emission");
+  const float scale = light_scale(params);
+  const Param* sp = params.find("scale");
+  return sp ? check_emission(rgb * scale, *sp, "emission") : rgb;
+}
+
+// A "power", "illuminance" or "scale" given as a multiplier of `value`.
+Rgb scaled_by(const ParamList& params, const char* name, Rgb value, float factor) {
+  return check_emission(value * factor, *params.find(name), "emission");
+}
+
+// Point and spot lights know their power at load time; it must be finite too (4 pi I can
+// overflow where I does not).
+void check_power(const Light& light, const SourceLocation& where) {
+  if (!light.power().is_finite())
+    throw SceneLoadError(where, "the light's total power overflows to infinity");
 }
 
 bool finite_vec(Vec3 v) { return is_finite(v); }
@@ -23,7 +54,8 @@ bool finite_vec(Vec3 v) { return is_finite(v); }
 AreaLightDesc make_area_light(const std::string& type, const ParamList& params,
                               const SourceLocation& where, LoaderContext& ctx) {
   if (type != "diffuse")
-    throw SceneLoadError(where, "unknown area light type \"" + type + "\" (expected \"diffuse\")");
+    throw SceneLoadError(
+        where, "unknown area light type " + quote_excerpt(type) + " (expected \"diffuse\")");
   AreaLightDesc a;
   a.where = where;
   if (const Param* fp = params.find("filename")) {
@@ -40,15 +72,16 @@ AreaLightDesc make_area_light(const std::string& type, const ParamList& params,
 void add_light_source(const std::string& type, const ParamList& params, const SourceLocation& where,
                       const Transform& light_to_world, MaterialFactory& images,
                       SceneBuilder& builder, LoaderContext& ctx) {
-  const std::string context = "LightSource \"" + type + "\"";
+  const std::string context = "LightSource " + quote_excerpt(type);
   LightPtr light;
   if (type == "point") {
     Rgb I = emission(params, "I", ctx);
     const float power = params.get_float("power", -1);
-    if (power > 0) I = I * (power / (4 * kPi));  // pbrt-v4: k_e = 4 pi
+    if (power > 0) I = scaled_by(params, "power", I, power / (4 * kPi));  // pbrt-v4: k_e = 4 pi
     const Vec3 from = light_to_world.point(params.get_point3("from", {0, 0, 0}));
     if (!finite_vec(from)) throw SceneLoadError(where, "point light position is not finite");
     light = make_point_light(from, I);
+    check_power(*light, where);
   } else if (type == "spot") {
     Rgb I = emission(params, "I", ctx);
     const float cone = params.get_float("coneangle", 30),
@@ -60,18 +93,19 @@ void add_light_source(const std::string& type, const ParamList& params, const So
       // pbrt-v4 SpotLight::Create: the power of the smoothstep cone.
       const float cos_end = std::cos(radians(cone)), cos_start = std::cos(radians(cone - delta));
       const float k_e = 2 * kPi * ((1 - cos_start) + (cos_start - cos_end) / 2);
-      if (k_e > 0) I = I * (power / k_e);
+      if (k_e > 0) I = scaled_by(params, "power", I, power / k_e);
     }
     const Vec3 p = light_to_world.point(from), dir = light_to_world.vector(to - from);
     if (!finite_vec(p) || !(length(dir) > 0) || !finite_vec(dir))
       throw SceneLoadError(where, "spot light transform is degenerate");
     light = make_spot_light(p, normalize(dir), I, cone, delta);
+    check_power(*light, where);
   } else if (type == "distant") {
     Rgb L = emission(params, "L", ctx);
     const Vec3 from = params.get_point3("from", {0, 0, 0}), to = params.get_point3("to", {0, 0, 1});
     if (from == to) throw SceneLoadError(where, "distant: \"from\" and \"to\" are the same point");
     const float illuminance = params.get_float("illuminance", -1);
-    if (illuminance > 0) L = L * illuminance;
+    if (illuminance > 0) L = scaled_by(params, "illuminance", L, illuminance);
     const Vec3 dir = light_to_world.vector(to - from);
     if (!(length(dir) > 0) || !finite_vec(dir))
       throw SceneLoadError(where, "distant light transform is degenerate");
@@ -85,7 +119,7 @@ void add_light_source(const std::string& type, const ParamList& params, const So
       ctx.warnings.warn(params.find("portal")->where,
                         "infinite light portals are not supported; ignored", "portal");
     if (fp) {
-      const float scale = params.get_float("scale", 1);
+      const float scale = light_scale(params);
       if (params.find("illuminance"))
         ctx.warnings.warn(params.find("illuminance")->where,
                           "\"illuminance\" is not supported for image infinite lights; ignored",
@@ -94,7 +128,7 @@ void add_light_source(const std::string& type, const ParamList& params, const So
       std::shared_ptr<const Image> image = images.load_image(path, false, *fp);
       EnvironmentMapping mapping = EnvironmentMapping::EqualAreaOctahedral;
       if (image->width() != image->height()) {
-        ctx.warnings.warn(fp->where, "environment map \"" + fp->strings[0] + "\" is " +
+        ctx.warnings.warn(fp->where, "environment map " + quote_excerpt(fp->strings[0]) + " is " +
                                          std::to_string(image->width()) + "x" +
                                          std::to_string(image->height()) +
                                          ", not square: reading it as lat-long (pbrt-v4 expects an "
@@ -105,17 +139,19 @@ void add_light_source(const std::string& type, const ParamList& params, const So
     } else {
       Rgb L = emission(params, "L", ctx);
       const float illuminance = params.get_float("illuminance", -1);
-      if (illuminance > 0) L = L * (illuminance / kPi);  // a uniform sky of radiance 1 gives E = pi
+      // A uniform sky of radiance 1 gives E = pi.
+      if (illuminance > 0) L = scaled_by(params, "illuminance", L, illuminance / kPi);
       light = make_uniform_environment(L);
     }
   } else if (type == "goniometric" || type == "projection") {
-    ctx.warnings.warn(where, "light \"" + type + "\" is not supported; skipped", "light " + type);
+    ctx.warnings.warn(where, "light " + quote_excerpt(type) + " is not supported; skipped",
+                      "light " + type);
     for (const Param& p : params.all()) p.used = true;
     return;
   } else {
     throw SceneLoadError(
-        where, "unknown light type \"" + type +
-                   "\" (expected point, spot, distant, infinite, goniometric or projection)");
+        where, "unknown light type " + quote_excerpt(type) +
+                   " (expected point, spot, distant, infinite, goniometric or projection)");
   }
   params.report_unused(ctx.warnings, context);
   builder.add_light(std::move(light));

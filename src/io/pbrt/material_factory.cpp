@@ -1,6 +1,8 @@
 #include "io/pbrt/material_factory.h"
 
 #include <algorithm>
+#include <filesystem>
+#include <limits>
 #include <stdexcept>
 
 #include "image/image_io.h"
@@ -24,6 +26,17 @@ class MixTexture final : public Texture {
   TexturePtr a_, b_, amount_;
 };
 
+// A constant float parameter must lie in [lo, hi]. Textured values are image data, read at
+// render time, and are not checked here.
+void check_constant_range(const ParamList& params, const std::string& name, float lo, float hi,
+                          const char* expected) {
+  for (const Param& p : params.all())  // not find(): that would mark the parameter used
+    if (p.name == name && p.type == ParamType::Float)
+      for (double v : p.numbers)
+        if (!(v >= lo && v <= hi))
+          param_error(p, std::string("expected ") + expected + ", got " + format_number(v));
+}
+
 bool is_constant_value(const TexturePtr& t, float v) {
   const auto* c = dynamic_cast<const ConstantTexture*>(t.get());
   return c && c->value() == Rgb(v);
@@ -46,12 +59,16 @@ std::shared_ptr<const Image> MaterialFactory::load_image(const std::string& path
   auto it = images_.find(key);
   if (it != images_.end()) return it->second;
   std::shared_ptr<const Image> image;
+  std::error_code ec;
+  // On Linux a directory opens as a stream and would be reported as a corrupt image.
+  if (std::filesystem::is_directory(path, ec))
+    param_error(where, quote_excerpt(path, kPathExcerpt) + " is a directory");
   try {
     image = std::make_shared<const Image>(read_image(path, srgb));
   } catch (const std::exception& e) {
     param_error(where, e.what());
   }
-  if (image->empty()) param_error(where, "\"" + path + "\" is an empty image");
+  if (image->empty()) param_error(where, quote_excerpt(path, kPathExcerpt) + " is an empty image");
   images_[key] = image;
   return image;
 }
@@ -72,7 +89,7 @@ TexturePtr MaterialFactory::spectrum_texture(const ParamList& params, const std:
     if (p->strings.size() != 1) param_error(*p, "expected one texture name");
     auto it = spectrum_textures_.find(p->strings[0]);
     if (it == spectrum_textures_.end())
-      param_error(*p, "no spectrum texture named \"" + p->strings[0] + "\"");
+      param_error(*p, "no spectrum texture named " + quote_excerpt(p->strings[0]));
     return it->second;
   }
   if (p->type == ParamType::Float) {
@@ -91,7 +108,7 @@ TexturePtr MaterialFactory::float_texture(const ParamList& params, const std::st
     if (p->strings.size() != 1) param_error(*p, "expected one texture name");
     auto it = float_textures_.find(p->strings[0]);
     if (it == float_textures_.end())
-      param_error(*p, "no float texture named \"" + p->strings[0] + "\"");
+      param_error(*p, "no float texture named " + quote_excerpt(p->strings[0]));
     return it->second;
   }
   if (p->numbers.size() != 1)
@@ -109,19 +126,19 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
   else if (type == "spectrum" || type == "color" || type == "rgb")
     is_float = false;
   else
-    throw SceneLoadError(where, "Texture \"" + name + "\": unknown texture type \"" + type +
-                                    "\" (expected \"float\" or \"spectrum\")");
+    throw SceneLoadError(where, "Texture " + quote_excerpt(name) + ": unknown texture type " +
+                                    quote_excerpt(type) + " (expected \"float\" or \"spectrum\")");
   auto& table = is_float ? float_textures_ : spectrum_textures_;
   if (table.count(name))
-    throw SceneLoadError(name_where, "texture \"" + name + "\" is defined twice");
+    throw SceneLoadError(name_where, "texture " + quote_excerpt(name) + " is defined twice");
 
-  const std::string context = "Texture \"" + cls + "\"";
+  const std::string context = "Texture " + quote_excerpt(cls);
   UvMapping mapping;
   auto read_mapping = [&]() {
     const std::string m = params.get_string("mapping", "uv");
     if (m != "uv")
       ctx_.warnings.warn(params.find("mapping")->where,
-                         "texture mapping \"" + m + "\" is not supported; using \"uv\"",
+                         "texture mapping " + quote_excerpt(m) + " is not supported; using \"uv\"",
                          "mapping " + m);
     mapping.su = params.get_float("uscale", 1);
     mapping.sv = params.get_float("vscale", 1);
@@ -140,6 +157,7 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
   } else if (cls == "mix") {
     TexturePtr a = texture_param(params, "tex1", is_float, Rgb(0.f));
     TexturePtr b = texture_param(params, "tex2", is_float, Rgb(1.f));
+    check_constant_range(params, "amount", 0, 1, "an amount between 0 and 1");
     tex = std::make_shared<MixTexture>(a, b, float_texture(params, "amount", 0.5f));
   } else if (cls == "checkerboard") {
     read_mapping();
@@ -166,26 +184,29 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
     else if (encoding == "linear")
       srgb = false;
     else if (encoding.rfind("gamma ", 0) == 0) {
-      ctx_.warnings.warn(params.find("encoding")->where,
-                         "imagemap encoding \"" + encoding + "\" is approximated by sRGB");
+      ctx_.warnings.warn(
+          params.find("encoding")->where,
+          "imagemap encoding " + quote_excerpt(encoding) + " is approximated by sRGB");
       srgb = true;
     } else {
-      param_error(*params.find("encoding"),
-                  "expected \"sRGB\", \"linear\" or \"gamma <value>\", got \"" + encoding + "\"");
+      param_error(
+          *params.find("encoding"),
+          "expected \"sRGB\", \"linear\" or \"gamma <value>\", got " + quote_excerpt(encoding));
     }
     const std::string filter = params.get_string("filter", "bilinear");
     if (filter != "bilinear" && filter != "point" && filter != "trilinear" && filter != "ewa" &&
         filter != "EWA")
       param_error(*params.find("filter"),
-                  "expected point, bilinear, trilinear or ewa, got \"" + filter + "\"");
+                  "expected point, bilinear, trilinear or ewa, got " + quote_excerpt(filter));
     if (filter != "bilinear")
-      ctx_.warnings.warn(params.find("filter")->where,
-                         "imagemap filter \"" + filter + "\" is not supported; using bilinear",
-                         "filter " + filter);
+      ctx_.warnings.warn(
+          params.find("filter")->where,
+          "imagemap filter " + quote_excerpt(filter) + " is not supported; using bilinear",
+          "filter " + filter);
     const std::string wrap = params.get_string("wrap", "repeat");
     if (wrap != "repeat")
       ctx_.warnings.warn(params.find("wrap")->where,
-                         "imagemap wrap \"" + wrap + "\" is not supported; using repeat",
+                         "imagemap wrap " + quote_excerpt(wrap) + " is not supported; using repeat",
                          "wrap " + wrap);
     params.find("maxanisotropy");
     const float scale = params.get_float("scale", 1);
@@ -193,13 +214,14 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
     tex = std::make_shared<ImageTexture>(load_image(path, srgb, *fp), mapping, Rgb(scale), invert);
   } else if (cls == "bilerp" || cls == "directionmix" || cls == "dots" || cls == "fbm" ||
              cls == "wrinkled" || cls == "windy" || cls == "marble" || cls == "ptex") {
-    ctx_.warnings.warn(where,
-                       "texture class \"" + cls + "\" is not supported; using a constant 0.5",
-                       "texture " + cls);
+    ctx_.warnings.warn(
+        where, "texture class " + quote_excerpt(cls) + " is not supported; using a constant 0.5",
+        "texture " + cls);
     for (const Param& p : params.all()) p.used = true;
     tex = make_constant_texture(Rgb(0.5f));
   } else {
-    throw SceneLoadError(where, "Texture \"" + name + "\": unknown texture class \"" + cls + "\"");
+    throw SceneLoadError(
+        where, "Texture " + quote_excerpt(name) + ": unknown texture class " + quote_excerpt(cls));
   }
   params.report_unused(ctx_.warnings, context);
   table[name] = std::move(tex);
@@ -208,12 +230,17 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
 MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamList& params,
                                            const SourceLocation& where,
                                            const NamedMaterialLookup& named) {
-  const std::string context = "Material \"" + type + "\"";
+  const std::string context = "Material " + quote_excerpt(type);
   if (params.find("displacement"))
     ctx_.warnings.warn(where, "material displacement is not supported; ignored", "displacement");
   if (params.find("normalmap"))
     ctx_.warnings.warn(where, "normal maps are not supported; ignored", "normalmap");
 
+  const float kInf = std::numeric_limits<float>::infinity();
+  // Negative roughness has no meaning (and its remapped alpha, sqrt(roughness), is NaN).
+  for (const char* name : {"roughness", "uroughness", "vroughness", "conductor.roughness",
+                           "conductor.uroughness", "conductor.vroughness"})
+    check_constant_range(params, name, 0, kInf, "a roughness >= 0");
   auto roughness = [&](TexturePtr* u, TexturePtr* v, bool* remap) {
     *u = float_texture(params, "uroughness", std::nullopt);
     *v = float_texture(params, "vroughness", std::nullopt);
@@ -330,6 +357,8 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
       throw SceneLoadError(mp ? mp->where : where,
                            "mix: \"string materials\" must name exactly two materials");
     MaterialPtr a = named(mp->strings[0], mp->where), b = named(mp->strings[1], mp->where);
+    // The amount is the probability of choosing the second material.
+    check_constant_range(params, "amount", 0, 1, "an amount between 0 and 1");
     TexturePtr amount = float_texture(params, "amount", 0.5f);
     if (!a && !b)
       m = nullptr;
@@ -341,7 +370,8 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
       m = make_mix(a, b, amount);
     }
   } else if (type == "measured" || type == "hair" || type == "subsurface") {
-    ctx_.warnings.warn(where, "material \"" + type + "\" is not supported; using diffuse",
+    ctx_.warnings.warn(where,
+                       "material " + quote_excerpt(type) + " is not supported; using diffuse",
                        "material " + type);
     TexturePtr r;
     if (type == "subsurface")
@@ -349,7 +379,7 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
     for (const Param& p : params.all()) p.used = true;
     m = make_diffuse(r ? r : make_constant_texture(Rgb(0.5f)));
   } else {
-    throw SceneLoadError(where, "unknown material type \"" + type + "\"");
+    throw SceneLoadError(where, "unknown material type " + quote_excerpt(type));
   }
   params.report_unused(ctx_.warnings, context);
   return m;

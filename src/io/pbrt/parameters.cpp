@@ -53,13 +53,23 @@ int tuple_size(ParamType t) {
   }
 }
 
-bool parse_number(const std::string& text, double* out) {
+enum class NumberParse { Ok, NotANumber, OutOfRange };
+
+// Every value ends up as a float (or an int), so a number that is finite as a double but
+// not as a float (1e39) would turn into infinity later, far from where it was written.
+// "inf" and "nan" parse as doubles and are rejected here too.
+NumberParse parse_number(const std::string& text, double* out) {
   const char* first = text.data();
   const char* last = text.data() + text.size();
   if (first != last && *first == '+') ++first;
-  if (first == last) return false;
+  if (first == last) return NumberParse::NotANumber;
   const auto [ptr, ec] = std::from_chars(first, last, *out);
-  return ec == std::errc() && ptr == last && std::isfinite(*out);
+  if (ptr != last) return NumberParse::NotANumber;
+  if (ec == std::errc::result_out_of_range) return NumberParse::OutOfRange;
+  if (ec != std::errc()) return NumberParse::NotANumber;
+  if (!std::isfinite(*out) || std::abs(*out) > std::numeric_limits<float>::max())
+    return NumberParse::OutOfRange;
+  return NumberParse::Ok;
 }
 
 }  // namespace
@@ -99,19 +109,18 @@ ParamList ParamList::parse(Tokenizer& tokens) {
     }
     if (words.size() != 2)
       throw SceneLoadError(
-          p.where,
-          "expected a parameter declaration \"type name\" (such as \"float fov\"), got \"" +
-              decl.text + "\"");
+          p.where, "expected a parameter declaration \"type name\" (such as \"float fov\"), got " +
+                       quote_excerpt(decl.text));
     const auto type = parse_type_name(words[0]);
     if (!type)
-      throw SceneLoadError(p.where,
-                           "unknown parameter type \"" + words[0] + "\" in \"" + decl.text + "\"");
+      throw SceneLoadError(p.where, "unknown parameter type " + quote_excerpt(words[0]) + " in " +
+                                        quote_excerpt(decl.text));
     p.type = *type;
     p.name = words[1];
     for (const Param& q : list.params_)
       if (q.name == p.name)
-        throw SceneLoadError(
-            p.where, "parameter \"" + p.name + "\" given twice (first at " + q.where.str() + ")");
+        throw SceneLoadError(p.where, "parameter " + quote_excerpt(p.name) +
+                                          " given twice (first at " + q.where.str() + ")");
 
     // Values: one bare value or a bracketed list.
     std::vector<Token> values;
@@ -138,9 +147,15 @@ ParamList ParamList::parse(Tokenizer& tokens) {
     const int tuple = tuple_size(p.type);
     auto expect_number = [&](const Token& v) {
       double d = 0;
-      if (v.kind != Token::Kind::Word || !parse_number(v.text, &d))
+      const NumberParse r =
+          v.kind == Token::Kind::Word ? parse_number(v.text, &d) : NumberParse::NotANumber;
+      if (r == NumberParse::NotANumber)
         throw SceneLoadError(tokens.location(v),
                              p.declaration() + ": expected a number, got " + describe(v));
+      if (r == NumberParse::OutOfRange)
+        throw SceneLoadError(tokens.location(v),
+                             p.declaration() + ": " + describe(v) +
+                                 " is not a finite number in the range of a 32-bit float");
       return d;
     };
     if (tuple > 0) {

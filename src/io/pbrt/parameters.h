@@ -48,7 +48,7 @@ struct Param {
   mutable bool used = false;
 
   std::string declaration() const {
-    return std::string("\"") + type_name(type) + " " + name + "\"";
+    return quote_excerpt(std::string(type_name(type)) + " " + name);
   }
 };
 

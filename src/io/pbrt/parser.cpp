@@ -192,11 +192,17 @@ void parse_impl(Tokenizer& tokens, DirectiveHandler& handler, const ParseOptions
         fs::path path(file.text);
         if (path.is_relative()) path = fs::path(tokens.file()).parent_path() / path;
         const std::string resolved = path.lexically_normal().string();
-        std::optional<std::string> text = options.read_file(resolved);
-        if (!text)
-          throw SceneLoadError(tokens.location(file),
-                               d.name + ": cannot read \"" + resolved + "\"");
-        Tokenizer included(std::move(*text), resolved);
+        std::string text;
+        try {
+          text = options.read_file(resolved);
+        } catch (const SceneLoadError&) {
+          throw;
+        } catch (const std::runtime_error& e) {
+          throw SceneLoadError(
+              tokens.location(file),
+              d.name + ": cannot read " + quote_excerpt(resolved, kPathExcerpt) + ": " + e.what());
+        }
+        Tokenizer included(std::move(text), resolved);
         parse_impl(included, handler, options, depth + 1);
         continue;
       }

@@ -31,9 +31,10 @@ class DirectiveHandler {
 };
 
 struct ParseOptions {
-  // Returns the contents of an Include/Import file, or nothing if it cannot be read. When
-  // unset, Include and Import are errors (in-memory parsing, fuzzing).
-  std::function<std::optional<std::string>(const std::string& path)> read_file;
+  // Returns the contents of an Include/Import file, or throws std::runtime_error saying why
+  // it cannot be read (the parser locates the message at the file name). When unset, Include
+  // and Import are errors (in-memory parsing, fuzzing).
+  std::function<std::string(const std::string& path)> read_file;
 };
 
 // Parses the whole token stream. Throws SceneLoadError at the first syntax error.

@@ -1,22 +1,13 @@
 #include "io/pbrt/pbrt_loader.h"
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
+#include "io/input_file.h"
 #include "io/pbrt/scene_converter.h"
 
 namespace caustica {
 
 namespace {
-
-std::optional<std::string> read_text_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 void convert(const std::string& text, const std::string& name, SceneBuilder& builder,
              pbrt::LoaderContext& ctx, const pbrt::ParseOptions& options) {
@@ -29,14 +20,18 @@ void convert(const std::string& text, const std::string& name, SceneBuilder& bui
 }  // namespace
 
 std::unique_ptr<Scene> load_pbrt(const std::string& path, WarningSink warn) {
-  std::optional<std::string> text = read_text_file(path);
-  if (!text) throw SceneLoadError({path, 0, 0}, "cannot open the scene file");
+  std::string text;
+  try {
+    text = read_input_file(path);
+  } catch (const std::runtime_error& e) {
+    throw SceneLoadError({path, 0, 0}, std::string("cannot open the scene file: ") + e.what());
+  }
   pbrt::LoaderContext ctx(warn);
   ctx.main_directory = std::filesystem::path(path).parent_path().string();
   pbrt::ParseOptions options;
-  options.read_file = read_text_file;
+  options.read_file = read_input_file;
   SceneBuilder builder;
-  convert(*text, path, builder, ctx, options);
+  convert(text, path, builder, ctx, options);
   return builder.build(std::filesystem::path(path).stem().string());
 }
 

@@ -9,6 +9,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "io/input_file.h"
+#include "io/load_error.h"
+
 namespace caustica::pbrt {
 
 namespace {
@@ -142,8 +145,8 @@ class DataReader {
     double v = 0;
     const auto [ptr, ec] = std::from_chars(first, last, v);
     if (ec != std::errc() || ptr != last)
-      fail(std::string("expected a number in ") + what + ", got \"" +
-           data_.substr(pos_, std::min<size_t>(end - pos_, 32)) + "\"");
+      fail(std::string("expected a number in ") + what + ", got " +
+           quote_excerpt(std::string_view(data_).substr(pos_, end - pos_)));
     pos_ = end;
     return v;
   }
@@ -203,7 +206,7 @@ PlyMesh parse_ply(const std::string& data) {
       else if (f == "binary_big_endian")
         format = Format::BinaryBig;
       else
-        fail(at + ": unknown format \"" + f + "\"");
+        fail(at + ": unknown format " + quote_excerpt(f));
       have_format = true;
     } else if (keyword == "element") {
       Element e;
@@ -223,15 +226,16 @@ PlyMesh parse_ply(const std::string& data) {
         p.is_list = true;
         if (!parse_scalar(count_type, &p.count_type) || !parse_scalar(item_type, &p.type) ||
             p.count_type == Scalar::Float32 || p.count_type == Scalar::Float64)
-          fail(at + ": bad list property \"" + line + "\"");
+          fail(at + ": bad list property " + quote_excerpt(line));
       } else {
         in >> p.name;
-        if (!parse_scalar(type, &p.type)) fail(at + ": unknown property type \"" + type + "\"");
+        if (!parse_scalar(type, &p.type))
+          fail(at + ": unknown property type " + quote_excerpt(type));
       }
       if (p.name.empty()) fail(at + ": property without a name");
       elements.back().properties.push_back(std::move(p));
     } else {
-      fail(at + ": unexpected \"" + keyword + "\"");
+      fail(at + ": unexpected " + quote_excerpt(keyword));
     }
   }
   if (!have_format) fail("the header has no \"format\" line");
@@ -346,13 +350,16 @@ PlyMesh parse_ply(const std::string& data) {
 }
 
 PlyMesh read_ply(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot open \"" + path + "\"");
-  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string data;
+  try {
+    data = read_input_file(path);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error("cannot read " + quote_excerpt(path, kPathExcerpt) + ": " + e.what());
+  }
   try {
     return parse_ply(data);
   } catch (const std::runtime_error& e) {
-    throw std::runtime_error("\"" + path + "\": " + e.what());
+    throw std::runtime_error(quote_excerpt(path, kPathExcerpt) + ": " + e.what());
   }
 }
 

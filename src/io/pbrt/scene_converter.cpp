@@ -59,10 +59,11 @@ std::string integrator_name(const std::string& pbrt_name, const SourceLocation& 
     return "bpt";
   }
   if (pbrt_name == "ambientocclusion" || pbrt_name == "aov") {
-    ctx.warnings.warn(where, "integrator \"" + pbrt_name + "\" is not available; using \"pt\"");
+    ctx.warnings.warn(where,
+                      "integrator " + quote_excerpt(pbrt_name) + " is not available; using \"pt\"");
     return "pt";
   }
-  throw SceneLoadError(where, "unknown integrator \"" + pbrt_name + "\"");
+  throw SceneLoadError(where, "unknown integrator " + quote_excerpt(pbrt_name));
 }
 
 void mark_all_used(const ParamList& params) {
@@ -164,8 +165,8 @@ void SceneConverter::handle(const Directive& d) {
   if (n == "CoordSysTransform") {
     auto it = coordinate_systems_.find(d.args[0]);
     if (it == coordinate_systems_.end())
-      ctx_.warnings.warn(d.arg_where[0], "CoordSysTransform: no coordinate system named \"" +
-                                             d.args[0] + "\"; ignored");
+      ctx_.warnings.warn(d.arg_where[0], "CoordSysTransform: no coordinate system named " +
+                                             quote_excerpt(d.args[0]) + "; ignored");
     else if (transforms_active_)
       state_.ctm = it->second;
     return;
@@ -182,7 +183,7 @@ void SceneConverter::handle(const Directive& d) {
     } else {
       throw SceneLoadError(
           d.arg_where[0],
-          "ActiveTransform: expected StartTime, EndTime or All, got \"" + which + "\"");
+          "ActiveTransform: expected StartTime, EndTime or All, got " + quote_excerpt(which));
     }
     return;
   }
@@ -225,8 +226,8 @@ void SceneConverter::handle(const Directive& d) {
         target != "texture")
       throw SceneLoadError(d.arg_where[0],
                            "Attribute: expected \"shape\", \"light\", \"material\", \"medium\" or "
-                           "\"texture\", got \"" +
-                               target + "\"");
+                           "\"texture\", got " +
+                               quote_excerpt(target));
     ParamList& list = state_.attributes[target];
     ParamList updated;
     for (const Param& p : d.params.all()) updated.add(p);
@@ -247,8 +248,8 @@ void SceneConverter::handle(const Directive& d) {
     camera_from_world_ = state_.ctm;
     coordinate_systems_["camera"] = state_.ctm.inverse();
     if (d.args[0] != "perspective") {
-      ctx_.warnings.warn(d.where,
-                         "camera \"" + d.args[0] + "\" is not supported; using \"perspective\"");
+      ctx_.warnings.warn(d.where, "camera " + quote_excerpt(d.args[0]) +
+                                      " is not supported; using \"perspective\"");
       mark_all_used(d.params);
     }
     camera_.fov_degrees = d.params.get_float("fov", 90);
@@ -268,14 +269,14 @@ void SceneConverter::handle(const Directive& d) {
             camera_.screen_window[2] < camera_.screen_window[3]))
         param_error(*sw, "expected xmin < xmax and ymin < ymax");
     }
-    d.params.report_unused(ctx_.warnings, "Camera \"" + d.args[0] + "\"");
+    d.params.report_unused(ctx_.warnings, "Camera " + quote_excerpt(d.args[0]));
     return;
   }
   if (n == "Film") {
     require_world(d, false);
     if (d.args[0] != "rgb" && d.args[0] != "gbuffer" && d.args[0] != "spectral")
-      throw SceneLoadError(
-          d.arg_where[0], "unknown film \"" + d.args[0] + "\" (expected rgb, gbuffer or spectral)");
+      throw SceneLoadError(d.arg_where[0], "unknown film " + quote_excerpt(d.args[0]) +
+                                               " (expected rgb, gbuffer or spectral)");
     camera_.width = d.params.get_int("xresolution", 1280);
     camera_.height = d.params.get_int("yresolution", 720);
     for (const char* r : {"xresolution", "yresolution"})
@@ -284,7 +285,7 @@ void SceneConverter::handle(const Directive& d) {
           param_error(*p, "expected a resolution between 1 and 65536");
     if (d.params.find("filename"))
       builder_.settings().output_name = d.params.get_string("filename", "");
-    d.params.report_unused(ctx_.warnings, "Film \"" + d.args[0] + "\"");
+    d.params.report_unused(ctx_.warnings, "Film " + quote_excerpt(d.args[0]));
     return;
   }
   if (n == "Sampler") {
@@ -301,15 +302,15 @@ void SceneConverter::handle(const Directive& d) {
     const int depth = d.params.get_int("maxdepth", 5);
     if (depth < 0) param_error(*d.params.find("maxdepth"), "must not be negative");
     builder_.settings().max_depth = depth;
-    d.params.report_unused(ctx_.warnings, "Integrator \"" + d.args[0] + "\"");
+    d.params.report_unused(ctx_.warnings, "Integrator " + quote_excerpt(d.args[0]));
     return;
   }
   if (n == "PixelFilter") {
     require_world(d, false);
     const auto kind = pixel_filter_kind(d.args[0]);
     if (!kind)
-      throw SceneLoadError(d.arg_where[0], "unknown pixel filter \"" + d.args[0] + "\" (expected " +
-                                               kPixelFilterNames + ")");
+      throw SceneLoadError(d.arg_where[0], "unknown pixel filter " + quote_excerpt(d.args[0]) +
+                                               " (expected " + kPixelFilterNames + ")");
     PixelFilterParams& f = camera_.filter = PixelFilterParams::defaults(*kind);
     f.radius = {d.params.get_float("xradius", f.radius.x),
                 d.params.get_float("yradius", f.radius.y)};
@@ -337,7 +338,8 @@ void SceneConverter::handle(const Directive& d) {
   }
   if (n == "ColorSpace") {
     if (d.args[0] != "srgb")
-      ctx_.warnings.warn(d.where, "ColorSpace \"" + d.args[0] + "\" is not supported; using srgb",
+      ctx_.warnings.warn(d.where,
+                         "ColorSpace " + quote_excerpt(d.args[0]) + " is not supported; using srgb",
                          "colorspace");
     return;
   }
@@ -371,13 +373,13 @@ void SceneConverter::handle(const Directive& d) {
   if (n == "MakeNamedMaterial") {
     const std::string& name = d.args[0];
     if (named_materials_.count(name))
-      throw SceneLoadError(d.arg_where[0], "named material \"" + name +
-                                               "\" is defined twice (first at " +
+      throw SceneLoadError(d.arg_where[0], "named material " + quote_excerpt(name) +
+                                               " is defined twice (first at " +
                                                named_materials_[name].where.str() + ")");
     ParamList params = with_attributes(d.params, "material");
     if (!params.find("type", {ParamType::String}))
-      throw SceneLoadError(d.where,
-                           "MakeNamedMaterial \"" + name + "\": \"string type\" is required");
+      throw SceneLoadError(
+          d.where, "MakeNamedMaterial " + quote_excerpt(name) + ": \"string type\" is required");
     named_materials_[name] = {params.get_string("type", ""), std::move(params), d.where};
     return;
   }
@@ -416,7 +418,7 @@ void SceneConverter::handle(const Directive& d) {
     }
     for (const char* ignored : {"emissionfilename"}) params.find(ignored);
     std::optional<ShapeGeometry> g = make_shape(d.args[0], params, d.where, ctx_);
-    params.report_unused(ctx_.warnings, "Shape \"" + d.args[0] + "\"");
+    params.report_unused(ctx_.warnings, "Shape " + quote_excerpt(d.args[0]));
     if (!g) return;
     ShapeRecord r;
     r.geometry = std::make_shared<const ShapeGeometry>(std::move(*g));
@@ -441,10 +443,11 @@ void SceneConverter::handle(const Directive& d) {
   }
   if (n == "ObjectBegin") {
     if (current_object_)
-      throw SceneLoadError(
-          d.where, "ObjectBegin inside the definition of object \"" + *current_object_ + "\"");
+      throw SceneLoadError(d.where, "ObjectBegin inside the definition of object " +
+                                        quote_excerpt(*current_object_));
     if (objects_.count(d.args[0]))
-      throw SceneLoadError(d.arg_where[0], "object \"" + d.args[0] + "\" is defined twice");
+      throw SceneLoadError(d.arg_where[0],
+                           "object " + quote_excerpt(d.args[0]) + " is defined twice");
     blocks_.push_back({'o', d.where, state_});
     current_object_ = d.args[0];
     objects_[d.args[0]];
@@ -463,11 +466,12 @@ void SceneConverter::handle(const Directive& d) {
   }
   if (n == "ObjectInstance") {
     if (current_object_)
-      throw SceneLoadError(
-          d.where, "ObjectInstance inside the definition of object \"" + *current_object_ + "\"");
+      throw SceneLoadError(d.where, "ObjectInstance inside the definition of object " +
+                                        quote_excerpt(*current_object_));
     auto it = objects_.find(d.args[0]);
     if (it == objects_.end())
-      throw SceneLoadError(d.arg_where[0], "ObjectInstance: no object named \"" + d.args[0] + "\"");
+      throw SceneLoadError(d.arg_where[0],
+                           "ObjectInstance: no object named " + quote_excerpt(d.args[0]));
     // Flattened: each shape is copied into world space (world-from-instance times the
     // shape's transform inside the definition), as pbrt-v4 composes them.
     for (const ShapeRecord& s : it->second) {
@@ -501,10 +505,11 @@ MaterialPtr SceneConverter::named_material(const std::string& name, const Source
   if (done != named_created_.end()) return done->second;
   auto it = named_materials_.find(name);
   if (it == named_materials_.end())
-    throw SceneLoadError(where, "no material named \"" + name + "\"");
+    throw SceneLoadError(where, "no material named " + quote_excerpt(name));
   for (const std::string& c : creating_)
     if (c == name)
-      throw SceneLoadError(where, "material \"" + name + "\" contains itself (through \"mix\")");
+      throw SceneLoadError(
+          where, "material " + quote_excerpt(name) + " contains itself (through \"mix\")");
   if (creating_.size() >= 64)
     throw SceneLoadError(where, "materials nested more than 64 deep (through \"mix\")");
   creating_.push_back(name);
@@ -528,6 +533,17 @@ MaterialPtr SceneConverter::material(const MaterialRef& ref) {
   }
   return *slot;
 }
+
+namespace {
+// "power" spread over a tiny area can overflow; the light's power (and the light selection
+// distribution) would then be infinite or NaN at render time.
+void check_area_emission(Rgb radiance, const AreaLightDesc& light) {
+  if (!radiance.is_finite())
+    throw SceneLoadError(light.where,
+                         "\"power\" over the area of a shape makes its radiance overflow to "
+                         "infinity");
+}
+}  // namespace
 
 void SceneConverter::emit_shape(const ShapeRecord& r) {
   MaterialPtr m = material(r.material);
@@ -560,6 +576,7 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
         if (r.emission->power > 0)
           e.radiance = e.radiance * (r.emission->power /
                                      ((e.two_sided ? 2 : 1) * 4 * kPi * sqr(sphere.radius) * kPi));
+        check_area_emission(e.radiance, *r.emission);
       }
       builder_.add_sphere(sphere, m, r.emission ? &e : nullptr);
       return;
@@ -605,6 +622,7 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
     AreaEmission ei = e;
     ei.radiance = area > 0 ? e.radiance * (r.emission->power / ((e.two_sided ? 2 : 1) * area * kPi))
                            : Rgb(0.f);
+    check_area_emission(ei.radiance, *r.emission);
     builder_.add_mesh(std::move(tri), m, &ei);
   }
 }

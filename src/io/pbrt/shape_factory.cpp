@@ -130,7 +130,8 @@ TriangleMesh make_ply(const ParamList& params, const SourceLocation& where, Load
   const std::string name = params.get_string("filename", "");
   const std::string path = ctx.resolve(name, fp->where);
   if (path.size() > 3 && path.substr(path.size() - 3) == ".gz")
-    param_error(*fp, "gzip-compressed PLY files are not supported; decompress \"" + name + "\"");
+    param_error(*fp, "gzip-compressed PLY files are not supported; decompress " +
+                         quote_excerpt(name, kPathExcerpt));
   PlyMesh ply;
   try {
     ply = read_ply(path);
@@ -138,7 +139,7 @@ TriangleMesh make_ply(const ParamList& params, const SourceLocation& where, Load
     param_error(*fp, e.what());
   }
   if (ply.skipped_faces > 0)
-    ctx.warnings.warn(fp->where, "plymesh \"" + name + "\": skipped " +
+    ctx.warnings.warn(fp->where, "plymesh " + quote_excerpt(name, kPathExcerpt) + ": skipped " +
                                      std::to_string(ply.skipped_faces) +
                                      " faces that are neither triangles nor quads");
   TriangleMesh mesh;
@@ -227,12 +228,13 @@ std::optional<ShapeGeometry> make_shape(const std::string& type, const ParamList
     }
   } else if (type == "curve" || type == "cylinder" || type == "cone" || type == "paraboloid" ||
              type == "hyperboloid" || type == "nurbs" || type == "heightfield") {
-    ctx.warnings.warn(where, "shape \"" + type + "\" is not supported; skipped", "shape " + type);
+    ctx.warnings.warn(where, "shape " + quote_excerpt(type) + " is not supported; skipped",
+                      "shape " + type);
     for (const Param& p : params.all()) p.used = true;
     return std::nullopt;
   } else {
-    throw SceneLoadError(where, "unknown shape \"" + type +
-                                    "\" (expected trianglemesh, plymesh, bilinearmesh, sphere, "
+    throw SceneLoadError(where, "unknown shape " + quote_excerpt(type) +
+                                    " (expected trianglemesh, plymesh, bilinearmesh, sphere, "
                                     "disk, cylinder, curve or loopsubdiv)");
   }
   return g;

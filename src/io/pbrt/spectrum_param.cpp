@@ -1,18 +1,26 @@
 #include "io/pbrt/spectrum_param.h"
 
 #include <charconv>
-#include <fstream>
+#include <cmath>
+#include <limits>
 #include <sstream>
+
+#include "io/input_file.h"
 
 namespace caustica::pbrt {
 
 namespace {
 
 std::vector<double> read_spectrum_file(const Param& p, const std::string& path) {
-  std::ifstream in(path);
-  if (!in)
-    param_error(
-        p, "\"" + p.strings[0] + "\" is neither a built-in named spectrum nor a readable file");
+  std::string text;
+  try {
+    text = read_input_file(path);
+  } catch (const std::runtime_error& e) {
+    param_error(p, quote_excerpt(p.strings[0]) +
+                       " is not a built-in named spectrum, and the file " +
+                       quote_excerpt(path, kPathExcerpt) + " cannot be read: " + e.what());
+  }
+  std::istringstream in(text);
   std::vector<double> values;
   std::string line;
   while (std::getline(in, line)) {
@@ -23,14 +31,19 @@ std::vector<double> read_spectrum_file(const Param& p, const std::string& path) 
     while (words >> w) {
       double v = 0;
       const auto [ptr, ec] = std::from_chars(w.data(), w.data() + w.size(), v);
-      if (ec != std::errc() || ptr != w.data() + w.size())
-        param_error(
-            p, "\"" + path + "\": expected numbers (wavelength, value pairs), got \"" + w + "\"");
+      // As in the scene file itself: "nan", "inf" and numbers beyond the float range are
+      // not spectrum values.
+      if (ec != std::errc() || ptr != w.data() + w.size() || !std::isfinite(v) ||
+          std::abs(v) > std::numeric_limits<float>::max())
+        param_error(p, quote_excerpt(path, kPathExcerpt) +
+                           ": expected finite numbers (wavelength, value pairs), got " +
+                           quote_excerpt(w));
       values.push_back(v);
     }
   }
   if (values.size() < 2 || values.size() % 2 != 0)
-    param_error(p, "\"" + path + "\": expected (wavelength, value) pairs, got " +
+    param_error(p, quote_excerpt(path, kPathExcerpt) +
+                       ": expected (wavelength, value) pairs, got " +
                        std::to_string(values.size()) + " numbers");
   return values;
 }
@@ -50,8 +63,19 @@ Rgb spectrum_param_rgb(const Param& p, SpectrumKind kind, LoaderContext& ctx) {
       // illuminant, so RGB emission comes out as written.
       return rgb;
     }
-    case ParamType::Blackbody:
-      return blackbody_rgb(float(p.numbers[0]));
+    case ParamType::Blackbody: {
+      const float kelvin = float(p.numbers[0]);
+      if (!(kelvin > 0))
+        param_error(
+            p, "expected a positive temperature in kelvin, got " + format_number(p.numbers[0]));
+      const Rgb rgb = blackbody_rgb(kelvin);
+      // Only reached for a few kelvin, where Planck's law underflows to zero everywhere in
+      // the visible range: such a light would silently be black.
+      if (!rgb.is_finite() || !(rgb.luminance() > 0))
+        param_error(p,
+                    "a blackbody at " + format_number(p.numbers[0]) + " K emits no visible light");
+      return rgb;
+    }
     case ParamType::Spectrum: {
       if (p.strings.empty()) return sampled_spectrum_rgb(p.numbers, kind);
       if (std::optional<Rgb> named = named_spectrum(p.strings[0])) {

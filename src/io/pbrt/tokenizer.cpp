@@ -11,12 +11,11 @@ std::string describe(const Token& token) {
     case Token::Kind::CloseBracket:
       return "\"]\"";
     case Token::Kind::String:
-      return "string \"" + token.text + "\"";
+      return "string " + quote_excerpt(token.text);
     case Token::Kind::Word:
       break;
   }
-  std::string text = token.text.size() > 40 ? token.text.substr(0, 40) + "..." : token.text;
-  return "\"" + text + "\"";
+  return quote_excerpt(token.text);
 }
 
 Tokenizer::Tokenizer(std::string text, std::string file)
@@ -122,7 +121,8 @@ Token Tokenizer::scan() {
           default:
             fail(el, ec,
                  std::string("unknown escape sequence '\\") +
-                     (e == '\n' ? std::string("newline") : std::string(1, e)) + "' in string");
+                     (e == '\n' ? std::string("newline") : escape_text(std::string(1, e))) +
+                     "' in string");
         }
         advance();
         continue;

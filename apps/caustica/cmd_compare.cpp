@@ -17,6 +17,7 @@
 #include "render/output.h"
 #include "render/progress.h"
 #include "render/renderer.h"
+#include "render/statistics.h"
 #include "scene/scene.h"
 #include "scene_setup.h"
 
@@ -64,20 +65,14 @@ int run_reference(const ReferenceOptions& o, const CheckedOptions& checks) {
   cb.stop = stop_flag();
   arm_graceful_stop();
   const RenderResult r = render(*scene, *integrator, budget, cb);
-  nlohmann::json meta = {{"kind", "reference"},
-                         {"scene", o.scene},
-                         {"integrator", o.integrator},
-                         {"seconds", r.seconds},
-                         {"iterations", r.iterations},
-                         {"seed", o.seed},
-                         {"interrupted", r.interrupted},
-                         {"threads", threads},
-                         {"max_depth", settings.max_depth},
-                         {"resolution", {scene->camera().width(), scene->camera().height()}},
-                         {"rays", r.rays},
-                         {"nonfinite_samples_discarded", r.nonfinite},
-                         {"peak_memory_mb", double(peak_memory_bytes()) / (1024 * 1024)}};
-  integrator->report(meta);
+  RunDescription run;
+  run.scene = o.scene;
+  run.integrator = o.integrator;
+  run.settings = settings;
+  run.threads = threads;
+  run.time_budget = o.seconds;
+  nlohmann::json meta = render_statistics(*scene, *integrator, r, run);
+  meta["kind"] = "reference";
   {
     FileSection writing;
     write_render_outputs(r.image, meta, paths, 0.f);
@@ -242,7 +237,7 @@ Runner add_compare_command(CLI::App& app) {
   cmd->add_option("scene", o->scene, "Scene name or file")->required();
   add_shared_options(*checks, o.get(), "Seconds per integrator")->required();
   cmd->add_option("--integrators", o->integrators,
-                  "Comma-separated integrators (default pt,bpt,vcm,ppm)");
+                  "Comma-separated integrators (default pt,bpt,vcm,ppm) of: " + integrator_help());
   cmd->add_option(
       "--reference", o->reference,
       "Reference image (EXR), the scene's resolution (default: render one first, 4x --time)");

@@ -17,6 +17,7 @@
 #include "preflight.h"
 #include "render/output.h"
 #include "render/renderer.h"
+#include "render/statistics.h"
 #include "scene/scene.h"
 #include "scene_setup.h"
 
@@ -32,13 +33,6 @@ struct RenderOptions : SharedOptions {
   float exposure = 0;
   bool quiet = false;
 };
-
-std::string iso_time_now() {
-  const std::time_t t = std::time(nullptr);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
-  return buf;
-}
 
 int run_render(const RenderOptions& o, const CheckedOptions& checks) {
   if (!checks.check()) return 2;
@@ -93,26 +87,14 @@ int run_render(const RenderOptions& o, const CheckedOptions& checks) {
   arm_graceful_stop();
   const RenderResult result = render(*scene, *integrator, budget, callbacks);
 
-  nlohmann::json stats;
-  stats["scene"] = scene_name;
-  stats["integrator"] = integrator_name;
-  stats["resolution"] = {scene->camera().width(), scene->camera().height()};
-  stats["iterations"] = result.iterations;
-  stats["interrupted"] = result.interrupted;
-  stats["spp"] = result.iterations;
-  stats["seconds"] = result.seconds;
-  stats["scene_load_seconds"] = load_seconds;
-  stats["rays"] = result.rays;
-  stats["rays_per_second"] = result.seconds > 0 ? double(result.rays) / result.seconds : 0.0;
-  stats["nonfinite_samples_discarded"] = result.nonfinite;
-  stats["peak_memory_mb"] = double(peak_memory_bytes()) / (1024 * 1024);
-  stats["threads"] = threads;
-  stats["seed"] = o.seed;
-  stats["max_depth"] = settings.max_depth;
-  stats["mis"] = o.mis.empty() ? "default" : o.mis;
-  stats["time_budget_seconds"] = o.seconds;
-  stats["finished_at"] = iso_time_now();
-  integrator->report(stats);
+  RunDescription run;
+  run.scene = scene_name;
+  run.integrator = integrator_name;
+  run.settings = settings;
+  run.threads = threads;
+  run.time_budget = o.seconds;
+  run.scene_load_seconds = load_seconds;
+  const nlohmann::json stats = render_statistics(*scene, *integrator, result, run);
 
   {
     FileSection writing;
@@ -147,10 +129,8 @@ Runner add_render_command(CLI::App& app) {
   cmd->add_option("scene", opts->scene_positional, "Scene name or file (default: cornell-glass)");
   cmd->add_option("--scene", opts->scene_flag,
                   "Scene name or file (same as the positional argument)");
-  std::string names;
-  for (const auto& n : integrator_names()) names += (names.empty() ? "" : ", ") + n;
   cmd->add_option("--integrator", opts->integrator,
-                  "Integrator: " + names + " (default: the scene's, else pt)");
+                  "Integrator (default: the scene's, else pt): " + integrator_help());
   checks->integer("--spp", &opts->spp, 1, std::numeric_limits<int>::max(),
                   "Samples (iterations) per pixel, at least 1 (default: the scene's, else 16)");
   add_shared_options(*checks, opts.get(), "Time budget in seconds (iterations until it is spent)");
@@ -161,6 +141,26 @@ Runner add_render_command(CLI::App& app) {
                  "PNG exposure in stops, -64..64 (EXR is never tone mapped)");
   cmd->add_flag("--quiet,-q", opts->quiet, "No progress bar or summary");
   return [opts, checks] { return run_render(*opts, *checks); };
+}
+
+std::string integrator_help() {
+  std::string help;
+  for (const IntegratorInfo& info : integrator_registry())
+    help += "\n  " + info.name + ": " + info.description;
+  return help;
+}
+
+Runner add_integrators_command(CLI::App& app) {
+  app.add_subcommand("integrators", "List the integrators, what each is, and its capabilities");
+  return [] {
+    for (const IntegratorInfo& info : integrator_registry())
+      std::printf("%-5s %-11s %-15s %-12s %s\n", info.name.c_str(),
+                  info.unbiased ? "unbiased" : "consistent",
+                  info.default_mis == MisHeuristic::Power ? "mis: power" : "mis: balance",
+                  info.caustics_through_specular ? "SDS: merges" : "SDS: no",
+                  info.description.c_str());
+    return 0;
+  };
 }
 
 Runner add_scenes_command(CLI::App& app) {

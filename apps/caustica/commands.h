@@ -11,6 +11,10 @@ using Runner = std::function<int()>;
 
 Runner add_render_command(CLI::App& app);
 Runner add_scenes_command(CLI::App& app);
+Runner add_integrators_command(CLI::App& app);
+
+// One line per integrator of the registry: "name: description", for option help.
+std::string integrator_help();
 Runner add_reference_command(CLI::App& app);
 Runner add_compare_command(CLI::App& app);
 

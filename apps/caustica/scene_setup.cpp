@@ -22,8 +22,8 @@ CLI::Option* add_shared_options(CheckedOptions& o, SharedOptions* s, const std::
   o.resolution("--resolution", &s->width, &s->height,
                "Override the film resolution, WxH (must fit in memory)");
   o.choice("--mis", &s->mis, {"balance", "power"},
-           "MIS heuristic: balance or power (default: power for pt, balance for the bidirectional "
-           "family)");
+           "MIS heuristic: balance or power (default: each integrator's own; `caustica "
+           "integrators` lists them)");
   o.integer("--camera", &s->camera, 0, std::numeric_limits<int>::max(),
             "glTF: which camera to use, in node order (default: the first)");
   o.integer(

@@ -5,10 +5,11 @@
 #include <cmath>
 #include <memory>
 
+#include "film/film.h"
 #include "image/metrics.h"
 #include "integrators/registry.h"
-#include "film/film.h"
 #include "render/renderer.h"
+#include "render/statistics.h"
 #include "scene/scene.h"
 
 namespace caustica {
@@ -88,7 +89,13 @@ ComparisonResult run_comparison(const Scene& scene, const Image& reference,
     run.rays = r.rays;
     run.nonfinite = r.nonfinite;
     run.snapshots.push_back({r.seconds, r.iterations, compute_errors(r.image, reference)});
-    integrator->report(run.integrator_stats);
+    RunDescription description;
+    description.scene = scene.name();
+    description.integrator = name;
+    description.settings = config.settings;
+    description.threads = config.threads;
+    description.time_budget = config.seconds;
+    run.integrator_stats = render_statistics(scene, *integrator, r, description);
     result.runs.push_back(std::move(run));
   }
   if (progress && !result.interrupted) progress(1.0, "done");

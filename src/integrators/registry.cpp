@@ -5,13 +5,57 @@
 
 namespace caustica {
 
-std::vector<std::string> integrator_names() { return {"pt", "lt", "bpt", "ppm", "bpm", "vcm"}; }
+namespace {
+
+std::function<std::unique_ptr<Integrator>(const IntegratorSettings&)> bidir(BidirAlgorithm a) {
+  return [a](const IntegratorSettings& s) { return make_bidir_integrator(a, s); };
+}
+
+std::vector<IntegratorInfo> make_registry() {
+  std::vector<IntegratorInfo> r;
+  r.push_back({"pt", "path tracing: BSDF sampling and next event estimation with MIS", true, true,
+               false, MisHeuristic::Power,
+               [](const IntegratorSettings& s) { return std::make_unique<PathTracer>(s); }});
+  r.push_back({"lt", "light tracing: light subpaths splatted to the camera", true, true, false,
+               MisHeuristic::Balance, bidir(BidirAlgorithm::LightTracing)});
+  r.push_back({"bpt", "bidirectional path tracing: every connection, MIS over all techniques", true,
+               true, false, MisHeuristic::Balance, bidir(BidirAlgorithm::Bpt)});
+  r.push_back({"ppm",
+               "progressive photon mapping: camera paths merge at their first diffuse vertex",
+               false, true, true, MisHeuristic::Balance, bidir(BidirAlgorithm::Ppm)});
+  r.push_back({"bpm", "bidirectional photon mapping: merging at every camera vertex, MIS", false,
+               true, true, MisHeuristic::Balance, bidir(BidirAlgorithm::Bpm)});
+  r.push_back({"vcm", "vertex connection and merging: bpt and bpm under one MIS", false, true, true,
+               MisHeuristic::Balance, bidir(BidirAlgorithm::Vcm)});
+  return r;
+}
+
+}  // namespace
+
+const std::vector<IntegratorInfo>& integrator_registry() {
+  static const std::vector<IntegratorInfo> registry = make_registry();
+  return registry;
+}
+
+const IntegratorInfo* find_integrator(const std::string& name) {
+  for (const IntegratorInfo& info : integrator_registry())
+    if (info.name == name) return &info;
+  return nullptr;
+}
+
+std::vector<std::string> integrator_names() {
+  std::vector<std::string> names;
+  for (const IntegratorInfo& info : integrator_registry()) names.push_back(info.name);
+  return names;
+}
 
 std::unique_ptr<Integrator> make_integrator(const std::string& name,
                                             const IntegratorSettings& settings) {
-  if (name == "pt") return std::make_unique<PathTracer>(settings);
-  if (auto bidir = make_bidir_integrator(name, settings)) return bidir;
-  return nullptr;
+  const IntegratorInfo* info = find_integrator(name);
+  if (!info) return nullptr;
+  IntegratorSettings s = settings;
+  if (!s.mis) s.mis = info->default_mis;
+  return info->make(s);
 }
 
 }  // namespace caustica

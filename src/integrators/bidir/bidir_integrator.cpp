@@ -659,14 +659,4 @@ std::unique_ptr<Integrator> make_bidir_integrator(BidirAlgorithm algorithm,
   return std::make_unique<BidirIntegrator>(algorithm, settings);
 }
 
-std::unique_ptr<Integrator> make_bidir_integrator(const std::string& name,
-                                                  const IntegratorSettings& settings) {
-  if (name == "lt") return make_bidir_integrator(BidirAlgorithm::LightTracing, settings);
-  if (name == "bpt") return make_bidir_integrator(BidirAlgorithm::Bpt, settings);
-  if (name == "ppm") return make_bidir_integrator(BidirAlgorithm::Ppm, settings);
-  if (name == "bpm") return make_bidir_integrator(BidirAlgorithm::Bpm, settings);
-  if (name == "vcm") return make_bidir_integrator(BidirAlgorithm::Vcm, settings);
-  return nullptr;
-}
-
 }  // namespace caustica

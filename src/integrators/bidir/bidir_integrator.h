@@ -34,9 +34,6 @@ namespace caustica {
 
 enum class BidirAlgorithm { LightTracing, Bpt, Ppm, Bpm, Vcm };
 
-// name: "lt", "bpt", "ppm", "bpm" or "vcm"; nullptr otherwise.
-std::unique_ptr<Integrator> make_bidir_integrator(const std::string& name,
-                                                  const IntegratorSettings& settings);
 std::unique_ptr<Integrator> make_bidir_integrator(BidirAlgorithm algorithm,
                                                   const IntegratorSettings& settings);
 

@@ -1,0 +1,175 @@
+// The oracles every integrator of the registry runs, without a test naming it by hand
+// (DESIGN.md, test oracle 5): the analytic furnaces, agreement with pt where its capability
+// flags say it can produce the paths, and bit-identical images for one and two threads. A new
+// integrator in src/integrators/registry.cpp gets all of them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "image/metrics.h"
+#include "integrators/registry.h"
+#include "io/builtin_scenes.h"
+#include "test_scenes.h"
+
+using namespace caustica;
+using namespace caustica::test;
+
+namespace {
+
+// Mean image value over `runs` independent renders (seeds), and its standard error from the
+// spread of the per-run means: valid even though bidirectional pixels share light paths.
+struct RunStats {
+  double mean = 0, standard_error = 0;
+};
+RunStats stats_over_seeds(const Scene& scene, const std::string& integrator, int spp,
+                          IntegratorSettings s, int runs) {
+  std::vector<double> means;
+  for (int k = 0; k < runs; ++k) {
+    s.seed = 1000 + k;
+    const auto r = render_with(scene, integrator, spp, s);
+    EXPECT_EQ(r.nonfinite, 0u) << integrator;
+    means.push_back(pixel_stats(r.image).mean);
+  }
+  double m = 0, v = 0;
+  for (double x : means) m += x;
+  m /= runs;
+  for (double x : means) v += (x - m) * (x - m);
+  v /= (runs - 1);
+  return {m, std::sqrt(v / runs)};
+}
+
+Image add(const Image& a, const Image& b) {
+  Image out = a;
+  for (size_t i = 0; i < out.pixel_count(); ++i) out[i] += b[i];
+  return out;
+}
+
+std::string test_name(std::string n) {
+  for (char& c : n)
+    if (c == '-') c = '_';
+  return n;
+}
+
+}  // namespace
+
+class RegistryOracle : public ::testing::TestWithParam<std::string> {
+ protected:
+  const IntegratorInfo& info() const { return *find_integrator(GetParam()); }
+};
+
+// Inside a closed diffuse sphere of albedo a emitting Le everywhere, radiance is Le / (1 - a).
+// Unbiased integrators: within 3 standard errors (over 6 seeds). Consistent ones (merging): the
+// furnace sphere has no curvature bias for merging (a ball of radius r centred on a sphere cuts a
+// cap of area exactly pi r^2, Archimedes) and the radiance is uniform, so the documented bound
+// adds only 1% * (r_i / r_1)^2 for the last iteration i, which shrinks with the radius.
+TEST_P(RegistryOracle, FurnaceMatchesAnalyticRadiance) {
+  FurnaceParams p;
+  p.albedo = 0.5f;
+  p.emission = 1.5f;
+  auto scene = make_furnace_scene(p, 24, 24);
+  IntegratorSettings s;
+  s.max_depth = 200;
+  s.bidir.radius = info().unbiased ? 0.05f : 0.1f;
+  const int spp = 8;
+  const RunStats st = stats_over_seeds(*scene, GetParam(), spp, s, 6);
+  const double shrink = std::pow(double(spp), s.bidir.radius_alpha - 1.0);  // (r_i / r_1)^2
+  const double bias = info().unbiased ? 0.0 : 0.01 * shrink * p.expected_radiance();
+  std::printf("[ furnace ] %-4s mean %.5f se %.5f (expected %.5f)\n", GetParam().c_str(), st.mean,
+              st.standard_error, p.expected_radiance());
+  EXPECT_NEAR(st.mean, p.expected_radiance(), 3 * st.standard_error + bias + 1e-5);
+  EXPECT_LT(st.standard_error, 0.01 * p.expected_radiance()) << "the test has power";
+}
+
+// Under a uniform environment of radiance 1, an albedo-1 diffuse object is invisible.
+TEST_P(RegistryOracle, EnvironmentFurnaceIsInvisible) {
+  auto scene = make_builtin_scene("env-furnace", 24, 24);
+  IntegratorSettings s;
+  s.max_depth = 200;
+  s.bidir.radius = 0.05f;
+  const RunStats st = stats_over_seeds(*scene, GetParam(), 4, s, 4);
+  EXPECT_NEAR(st.mean, 1.0, 3 * st.standard_error + (info().unbiased ? 1e-5 : 0.01))
+      << " se " << st.standard_error;
+}
+
+// Agreement with pt where no path is delta-only (cornell, cornell-glossy), for every integrator
+// whose flags say it samples every such path. The bound is derived from measured noise. With a
+// common normalisation (the pt average as reference, eps 0.01 as rel_mse), d(a, b) = mean of
+// (a - b)^2 / (ref^2 + eps) gives E[d(x1, x2)] = 2 v_x for two independent renders of an unbiased
+// integrator with normalised variance v_x. Comparing the averages of two renders each,
+// E[d(avg_x, avg_pt)] = v_x / 2 + v_pt / 2 + bias^2 = (n_x + n_pt) / 4 with n = d(render 1, render
+// 2). The test requires d(avg_x, avg_pt) < 1.5 (n_x + n_pt) / 4: a bias adds to the left side only.
+TEST_P(RegistryOracle, AgreesWithPathTracing) {
+  if (GetParam() == "pt") GTEST_SKIP() << "pt is the reference";
+  if (!info().every_path_without_delta) GTEST_SKIP() << "cannot sample every such path";
+  auto normalised_diff = [](const Image& a, const Image& b, const Image& ref) {
+    double sum = 0;
+    for (size_t i = 0; i < a.pixel_count(); ++i)
+      for (int c = 0; c < 3; ++c)
+        sum += sqr(double(a[i][c]) - b[i][c]) / (sqr(double(ref[i][c])) + 0.01);
+    return sum / (3.0 * a.pixel_count());
+  };
+  for (const char* scene_name : {"cornell", "cornell-glossy"}) {
+    auto scene = make_builtin_scene(scene_name, 32, 32);
+    IntegratorSettings s;
+    s.max_depth = 5;
+    s.bidir.radius = 0.01f;
+    int spp = 32;
+    if (!info().unbiased) {  // merging: enough photons for its noise to be small
+      s.bidir.radius = 0.03f;
+      s.bidir.light_paths = 8192;
+    }
+    auto render_seed = [&](const std::string& name, int n, uint64_t seed) {
+      IntegratorSettings t = s;
+      t.seed = seed;
+      return render_with(*scene, name, n, t).image;
+    };
+    const Image pt_a = render_seed("pt", 128, 1), pt_b = render_seed("pt", 128, 2);
+    const Image x_a = render_seed(GetParam(), spp, 3), x_b = render_seed(GetParam(), spp, 4);
+    Image pt_avg = add(pt_a, pt_b), x_avg = add(x_a, x_b);
+    for (Rgb& v : pt_avg.pixels()) v *= 0.5f;
+    for (Rgb& v : x_avg.pixels()) v *= 0.5f;
+    const double noise_pt = normalised_diff(pt_a, pt_b, pt_avg),
+                 noise_x = normalised_diff(x_a, x_b, pt_avg);
+    const double diff = normalised_diff(x_avg, pt_avg, pt_avg);
+    const double expected = (noise_pt + noise_x) / 4, bound = 1.5 * expected;
+    std::printf("[ agreement ] %-14s %-4s diff %.5f  expected from noise %.5f; rel_mse %.5f\n",
+                scene_name, GetParam().c_str(), diff, expected, rel_mse(x_avg, pt_avg));
+    EXPECT_LT(diff, bound) << scene_name;
+  }
+}
+
+// Random streams are keyed by pixel or path and iteration, never by thread.
+TEST_P(RegistryOracle, BitIdenticalForOneAndTwoThreads) {
+  auto scene = make_builtin_scene("cornell-glass", 40, 40);
+  IntegratorSettings s;
+  s.bidir.light_paths = 3000;  // not a multiple of the light-path chunk size
+  const auto a = render_with(*scene, GetParam(), 3, s, 1);
+  const auto b = render_with(*scene, GetParam(), 3, s, 2);
+  ASSERT_EQ(a.image.pixel_count(), b.image.pixel_count());
+  size_t differing = 0;
+  for (size_t i = 0; i < a.image.pixel_count(); ++i)
+    if (!(a.image[i] == b.image[i])) ++differing;
+  EXPECT_EQ(differing, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Registry, RegistryOracle, ::testing::ValuesIn(integrator_names()),
+                         [](const auto& info) { return test_name(info.param); });
+
+// The README's integrator table (the rows of its "## Integrators" section that start with a
+// backquoted name) lists exactly the registry, in its order.
+TEST(Registry, ReadmeTableListsExactlyTheRegistry) {
+  std::ifstream readme(std::filesystem::path(CAUSTICA_SCENES).parent_path() / "README.md");
+  ASSERT_TRUE(readme) << "README.md not found";
+  std::vector<std::string> rows;
+  bool in_section = false;
+  for (std::string line; std::getline(readme, line);) {
+    if (line.rfind("## ", 0) == 0) in_section = line == "## Integrators";
+    if (in_section && line.rfind("| `", 0) == 0) {
+      const size_t end = line.find('`', 3);
+      rows.push_back(line.substr(3, end - 3));
+    }
+  }
+  EXPECT_EQ(rows, integrator_names());
+}

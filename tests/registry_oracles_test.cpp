@@ -157,18 +157,22 @@ TEST_P(RegistryOracle, BitIdenticalForOneAndTwoThreads) {
 INSTANTIATE_TEST_SUITE_P(Registry, RegistryOracle, ::testing::ValuesIn(integrator_names()),
                          [](const auto& info) { return test_name(info.param); });
 
-// The README's integrator table (the rows of its "## Integrators" section that start with a
-// backquoted name) lists exactly the registry, in its order.
+// The README's integrator table (the table headed "| name |" in its "## Integrators" section)
+// lists exactly the registry, in its order.
 TEST(Registry, ReadmeTableListsExactlyTheRegistry) {
   std::ifstream readme(std::filesystem::path(CAUSTICA_SCENES).parent_path() / "README.md");
   ASSERT_TRUE(readme) << "README.md not found";
   std::vector<std::string> rows;
-  bool in_section = false;
-  for (std::string line; std::getline(readme, line);) {
+  bool in_section = false, in_table = false, done = false;
+  for (std::string line; !done && std::getline(readme, line);) {
     if (line.rfind("## ", 0) == 0) in_section = line == "## Integrators";
-    if (in_section && line.rfind("| `", 0) == 0) {
-      const size_t end = line.find('`', 3);
-      rows.push_back(line.substr(3, end - 3));
+    if (!in_section) continue;
+    if (line.rfind("| name |", 0) == 0) {
+      in_table = true;
+    } else if (in_table && line.rfind("| `", 0) == 0) {
+      rows.push_back(line.substr(3, line.find('`', 3) - 3));
+    } else if (in_table && line.rfind("|", 0) != 0) {
+      done = true;  // the first line after the table
     }
   }
   EXPECT_EQ(rows, integrator_names());

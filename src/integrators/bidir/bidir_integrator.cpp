@@ -230,7 +230,12 @@ class BidirIntegrator final : public Integrator {
         bidir::LightPathAssignment(film.pixel_count(), light_paths_, iteration, settings_.seed);
 
     trace_light_paths(scene, it, film);
-    if (tech_.merge) grid_.build(vertices_, it.radius);
+    if (tech_.merge) {
+      const auto grid_start = std::chrono::steady_clock::now();
+      grid_.build(vertices_, it.radius);
+      grid_seconds_total_ +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - grid_start).count();
+    }
     trace_camera_paths(scene, it, film);
 
     ++iterations_;
@@ -254,6 +259,8 @@ class BidirIntegrator final : public Integrator {
     b["bytes_per_light_vertex"] = sizeof(LightVertex);
     b["light_vertex_buffer_bytes"] = vertices_.capacity() * sizeof(LightVertex);
     b["hash_grid_bytes"] = grid_.memory_bytes();
+    if (tech_.merge)
+      b["hash_grid_build_ms_per_iteration"] = iterations_ ? 1e3 * grid_seconds_total_ / iterations_ : 0.0;
     b["radius_initial"] = base_radius_;
     b["radius_last"] = last_radius_;
     b["radius_alpha"] = settings_.radius_alpha;
@@ -667,6 +674,7 @@ class BidirIntegrator final : public Integrator {
   uint32_t iterations_ = 0;
   uint64_t vertices_total_ = 0;
   double seconds_total_ = 0;
+  double grid_seconds_total_ = 0;  // of seconds_total_, building the hash grid
   std::vector<std::string> technique_files_;
 };
 

@@ -36,7 +36,14 @@ using bidir::LightVertexData;
 using bidir::MisRules;
 using bidir::MisSums;
 
-constexpr uint32_t kChunkPaths = 1024;  // light paths per chunk: fixed, independent of threads
+// Light paths per chunk: at most 1024, fewer when that would leave fewer than 64 chunks (a small
+// image has few light paths; 4 chunks of 1024 kept 2 threads half idle at 64x64). It depends on
+// the path count only, never on the threads, and the vertices and splats are concatenated in
+// path order whatever the chunk size: the images do not depend on it.
+constexpr uint64_t kMaxChunkPaths = 1024, kMinChunkPaths = 64, kMinChunks = 64;
+uint64_t chunk_paths_for(uint64_t light_paths) {
+  return std::clamp((light_paths + kMinChunks - 1) / kMinChunks, kMinChunkPaths, kMaxChunkPaths);
+}
 constexpr float kDefaultRadiusFactor = 0.003f;
 
 // Which techniques take part (tech. rep. section 6, SmallVCM's switches).
@@ -211,8 +218,9 @@ class BidirIntegrator final : public Integrator {
                                         : kDefaultRadiusFactor * std::max(scene_radius, 1e-3f);
     light_paths_ = settings_.light_paths > 0 ? settings_.light_paths : film.pixel_count();
     if (!settings_.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
-    const uint64_t chunks = (light_paths_ + kChunkPaths - 1) / kChunkPaths;
-    chunks_.resize(chunks);
+    chunk_paths_ = chunk_paths_for(light_paths_);
+    chunks_.resize((light_paths_ + chunk_paths_ - 1) / chunk_paths_);
+    chunk_offset_.resize(chunks_.size());
   }
 
   void render_iteration(const Scene& scene, uint32_t iteration, Film& film) override {
@@ -281,8 +289,8 @@ class BidirIntegrator final : public Integrator {
       chunk.path_ends.clear();
       chunk.splats.clear();
       chunk.nonfinite = 0;
-      const uint64_t first = c * kChunkPaths,
-                     last = std::min<uint64_t>(first + kChunkPaths, light_paths_);
+      const uint64_t first = c * chunk_paths_,
+                     last = std::min<uint64_t>(first + chunk_paths_, light_paths_);
       for (uint64_t path = first; path < last; ++path) {
         arena.reset();
         trace_light_path(scene, it, path, chunk, arena);
@@ -295,7 +303,7 @@ class BidirIntegrator final : public Integrator {
     for (const LightChunk& c : chunks_) total += c.vertices.size();
     vertices_.resize(total);
     path_begin_.resize(light_paths_ + 1);
-    std::vector<size_t> chunk_offset(chunks_.size());
+    std::vector<size_t>& chunk_offset = chunk_offset_;
     for (size_t c = 0, offset = 0; c < chunks_.size(); ++c) {
       chunk_offset[c] = offset;
       offset += chunks_[c].vertices.size();
@@ -303,7 +311,7 @@ class BidirIntegrator final : public Integrator {
     tbb::parallel_for(size_t(0), chunks_.size(), [&](size_t c) {
       const LightChunk& chunk = chunks_[c];
       std::copy(chunk.vertices.begin(), chunk.vertices.end(), vertices_.begin() + chunk_offset[c]);
-      const uint64_t first = c * kChunkPaths;
+      const uint64_t first = c * chunk_paths_;
       for (size_t i = 0; i < chunk.path_ends.size(); ++i) {
         path_begin_[first + i] = uint32_t(chunk_offset[c] + (i ? chunk.path_ends[i - 1] : 0));
       }
@@ -663,7 +671,9 @@ class BidirIntegrator final : public Integrator {
   uint64_t light_paths_ = 0;
 
   // Per-iteration buffers, reused.
+  uint64_t chunk_paths_ = kMaxChunkPaths;  // light paths per chunk (chunk_paths_for)
   std::vector<LightChunk> chunks_;
+  std::vector<size_t> chunk_offset_;  // per chunk: its first vertex in vertices_
   std::vector<LightVertex> vertices_;
   std::vector<uint32_t> path_begin_;
   HashGrid grid_;

@@ -7,7 +7,10 @@
 //   ms_per_iteration, rays_per_second (caustica's intersect + occluded calls),
 //   paths_per_second ((camera paths + light paths) per second; one camera path per pixel),
 //   embree_*_rays_per_second and embree_bound_rays_per_second (Embree alone on caustica's mix of
-//   closest-hit and occlusion rays), ratio_to_embree (caustica / bound),
+//   closest-hit and occlusion rays), ratio_to_embree (caustica / bound). The bound's rays are
+//   incoherent bounce rays; caustica's also include camera rays and shadow rays toward a small
+//   light, which traverse less, so the ratio can exceed 1 on a large scene (many-triangles pt):
+//   read it as "Embree time share", not as a hard limit,
 //   peak_memory_mb (the process's peak resident memory during that render, when Linux lets the
 //   peak be reset; else the process's peak so far, and peak_memory_scope says "process"; it
 //   includes the scene and the bench's own ray buffers), render_memory_mb (that peak less the

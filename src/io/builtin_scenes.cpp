@@ -184,7 +184,7 @@ std::vector<BuiltinSceneInfo> builtin_scenes() {
       {"cornell", "Cornell box, diffuse only, area light"},
       {"cornell-glossy", "Cornell box with two rough metal spheres (no delta paths)"},
       {"furnace", "camera inside a closed diffuse sphere, albedo 0.5, emitting 1: radiance is exactly 2"},
-      {"many-triangles", "Cornell box whose floor is a displaced height field of 1,002,528 triangles, glass sphere"},
+      {"many-triangles", "Cornell box, floor a 1,002,528-triangle height field, glass sphere"},
       {"env-furnace", "albedo-1 diffuse sphere under a uniform environment of radiance 1: every pixel is 1"},
   };
 }

@@ -268,7 +268,8 @@ class BidirIntegrator final : public Integrator {
     b["light_vertex_buffer_bytes"] = vertices_.capacity() * sizeof(LightVertex);
     b["hash_grid_bytes"] = grid_.memory_bytes();
     if (tech_.merge)
-      b["hash_grid_build_ms_per_iteration"] = iterations_ ? 1e3 * grid_seconds_total_ / iterations_ : 0.0;
+      b["hash_grid_build_ms_per_iteration"] =
+          iterations_ ? 1e3 * grid_seconds_total_ / iterations_ : 0.0;
     b["radius_initial"] = base_radius_;
     b["radius_last"] = last_radius_;
     b["radius_alpha"] = settings_.radius_alpha;

@@ -23,8 +23,6 @@
 
 namespace caustica::cli {
 
-namespace {
-
 std::vector<std::string> split_list(const std::string& s) {
   std::vector<std::string> out;
   std::stringstream ss(s);
@@ -33,6 +31,8 @@ std::vector<std::string> split_list(const std::string& s) {
     if (!item.empty()) out.push_back(item);
   return out;
 }
+
+namespace {
 
 struct ReferenceOptions : SharedOptions {
   std::string integrator = "pt";

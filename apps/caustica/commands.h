@@ -17,6 +17,10 @@ Runner add_integrators_command(CLI::App& app);
 std::string integrator_help();
 Runner add_reference_command(CLI::App& app);
 Runner add_compare_command(CLI::App& app);
+Runner add_bench_command(CLI::App& app);
+
+// "a,b,,c" -> {"a", "b", "c"}.
+std::vector<std::string> split_list(const std::string& s);
 
 // Parses a name against a list; on failure prints "unknown <what> 'x'; valid: a, b" and
 // returns false.

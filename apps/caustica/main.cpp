@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   add(caustica::cli::add_compare_command);
   add(caustica::cli::add_scenes_command);
   add(caustica::cli::add_integrators_command);
+  add(caustica::cli::add_bench_command);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,5 +1,7 @@
 #include "io/builtin_scenes.h"
 
+#include <cmath>
+
 #include "io/scene_builder.h"
 #include "lights/lights.h"
 #include "materials/materials.h"
@@ -108,6 +110,39 @@ std::unique_ptr<Scene> cornell_glossy(int w, int h) {
   return b.build("cornell-glossy");
 }
 
+// A Cornell box whose floor is covered by a displaced height field of about a million
+// triangles, with the glass sphere resting on it: enough geometry that BVH traversal, not
+// shading, dominates a ray's cost (`caustica bench`). Deterministic: the heights are a fixed sum
+// of sines, no random numbers.
+std::unique_ptr<Scene> many_triangles(int w, int h) {
+  SceneBuilder b;
+  add_cornell_box(b);
+  constexpr int kQuads = 708;  // 2 * 708^2 = 1,002,528 triangles
+  constexpr float x0 = -1.27029f, x1 = 1.28975f, y0 = -1.25549f, y1 = 1.30455f, floor = -1.28002f;
+  TriangleMesh field;
+  field.positions.reserve(size_t(kQuads + 1) * (kQuads + 1));
+  for (int j = 0; j <= kQuads; ++j)
+    for (int i = 0; i <= kQuads; ++i) {
+      const float x = x0 + (x1 - x0) * float(i) / kQuads, y = y0 + (y1 - y0) * float(j) / kQuads;
+      // Dunes plus a fine ripple (period ~ 8 quads) so that neighbouring triangles differ.
+      const float dunes = 0.5f + 0.5f * std::sin(4.1f * x + 1.3f) * std::cos(3.7f * y - 0.4f);
+      const float ripple = 0.5f + 0.5f * std::sin(170.f * x + 40.f * y);
+      field.positions.emplace_back(x, y, floor + 0.01f + 0.18f * dunes + 0.012f * ripple);
+    }
+  field.indices.reserve(size_t(kQuads) * kQuads * 6);
+  for (int j = 0; j < kQuads; ++j)
+    for (int i = 0; i < kQuads; ++i) {
+      const uint32_t a = uint32_t(j * (kQuads + 1) + i), c = a + kQuads + 1;
+      field.indices.insert(field.indices.end(), {a, a + 1, c + 1, a, c + 1, c});
+    }
+  b.add_mesh(std::move(field), diffuse(Rgb(0.75f, 0.65f, 0.45f)));
+  DielectricParams glass;
+  glass.eta = 1.6f;
+  b.add_sphere({kRightSphere + Vec3(0, 0, 0.15f), 0.5f}, make_dielectric(glass));
+  finish_cornell(b, w, h);
+  return b.build("many-triangles");
+}
+
 // The camera at the origin looking down +y, inside whatever surrounds it.
 CameraParams origin_camera(int w, int h, float fov) {
   CameraParams c;
@@ -149,6 +184,7 @@ std::vector<BuiltinSceneInfo> builtin_scenes() {
       {"cornell", "Cornell box, diffuse only, area light"},
       {"cornell-glossy", "Cornell box with two rough metal spheres (no delta paths)"},
       {"furnace", "camera inside a closed diffuse sphere, albedo 0.5, emitting 1: radiance is exactly 2"},
+      {"many-triangles", "Cornell box, floor a 1,002,528-triangle height field, glass sphere"},
       {"env-furnace", "albedo-1 diffuse sphere under a uniform environment of radiance 1: every pixel is 1"},
   };
 }
@@ -159,6 +195,7 @@ std::unique_ptr<Scene> make_builtin_scene(const std::string& name, int w, int h)
   if (name == "cornell-glossy") return cornell_glossy(w, h);
   if (name == "furnace") return make_furnace_scene(FurnaceParams{}, w > 0 ? w : 32, h > 0 ? h : 32);
   if (name == "env-furnace") return env_furnace(w, h);
+  if (name == "many-triangles") return many_triangles(w, h);
   return nullptr;
 }
 

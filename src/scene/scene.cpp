@@ -107,7 +107,10 @@ struct Scene::Impl {
   std::vector<int> mesh_of_geom;          // Embree geometry id -> mesh index (-1: spheres)
   std::vector<uint32_t> first_primitive;  // Embree geometry id -> its first dense primitive index
   SphereGeometry sphere_geometry{};
-  mutable tbb::enumerable_thread_specific<uint64_t> rays{0};
+  struct RayCounts {
+    uint64_t all = 0, occlusion = 0;
+  };
+  mutable tbb::enumerable_thread_specific<RayCounts> rays;
   std::string error;
 
   ~Impl() {
@@ -220,7 +223,13 @@ size_t Scene::triangle_count() const {
 
 uint64_t Scene::rays_traced() const {
   uint64_t n = 0;
-  for (uint64_t v : impl_->rays) n += v;
+  for (const Impl::RayCounts& c : impl_->rays) n += c.all;
+  return n;
+}
+
+uint64_t Scene::occlusion_rays_traced() const {
+  uint64_t n = 0;
+  for (const Impl::RayCounts& c : impl_->rays) n += c.occlusion;
   return n;
 }
 
@@ -240,7 +249,9 @@ static void fill_ray(const Ray& r, RTCRay* out) {
 }
 
 bool Scene::occluded(const Ray& ray) const {
-  ++impl_->rays.local();
+  Impl::RayCounts& counts = impl_->rays.local();
+  ++counts.all;
+  ++counts.occlusion;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRay r;
@@ -250,7 +261,7 @@ bool Scene::occluded(const Ray& ray) const {
 }
 
 bool Scene::intersect(const Ray& ray, SurfaceInteraction* si) const {
-  ++impl_->rays.local();
+  ++impl_->rays.local().all;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh;
@@ -266,6 +277,36 @@ bool Scene::intersect(const Ray& ray, SurfaceInteraction* si) const {
   if (rh.hit.geomID == impl_->sphere_geom_id) p_sphere = ray.o + ray.d * si->t;
   complete_hit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, p_sphere, si);
   return true;
+}
+
+uint64_t Scene::intersect_raw(const Ray* rays, size_t n, float* t_hit) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  uint64_t hits = 0;
+  for (size_t i = 0; i < n; ++i) {
+    RTCRayHit rh;
+    fill_ray(rays[i], &rh.ray);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(impl_->scene, &ctx, &rh);
+    const bool hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    hits += hit;
+    t_hit[i] = hit ? rh.ray.tfar : kInfinity;
+  }
+  return hits;
+}
+
+uint64_t Scene::occluded_raw(const Ray* rays, size_t n) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  uint64_t occluded = 0;
+  for (size_t i = 0; i < n; ++i) {
+    RTCRay r;
+    fill_ray(rays[i], &r);
+    rtcOccluded1(impl_->scene, &ctx, &r);
+    occluded += r.tfar < 0;
+  }
+  return occluded;
 }
 
 void Scene::complete_hit(uint32_t geom_id, uint32_t prim_id, float b1, float b2, Vec3 p_sphere,

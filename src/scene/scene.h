@@ -71,8 +71,17 @@ class Scene {
   size_t triangle_count() const;
   size_t sphere_count() const { return spheres_.size(); }
 
-  // Rays traced through intersect/occluded since construction (all threads).
+  // Rays traced through intersect/occluded since construction (all threads), and how many of
+  // them were occlusion rays (the bench weighs the raw Embree bound by this mix).
   uint64_t rays_traced() const;
+  uint64_t occlusion_rays_traced() const;
+
+  // The raw Embree kernels, for measuring the bound a renderer on this BVH cannot beat
+  // (scene/ray_bench.h): rtcIntersect1 / rtcOccluded1 on rays[0, n) with no hit record and
+  // no ray counting. intersect_raw writes each ray's closest-hit distance (infinity on a miss)
+  // to t_hit and returns the number of hits; occluded_raw returns the number occluded.
+  uint64_t intersect_raw(const Ray* rays, size_t n, float* t_hit) const;
+  uint64_t occluded_raw(const Ray* rays, size_t n) const;
 
   // Compact primitive references for stored path vertices (the bidirectional core keeps light
   // vertices small and rebuilds their hit records on demand): a dense index over all triangles

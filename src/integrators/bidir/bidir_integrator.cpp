@@ -37,7 +37,14 @@ using bidir::LightVertexData;
 using bidir::MisRules;
 using bidir::MisSums;
 
-constexpr uint32_t kChunkPaths = 1024;  // light paths per chunk: fixed, independent of threads
+// Light paths per chunk: at most 1024, fewer when that would leave fewer than 64 chunks (a small
+// image has few light paths; 4 chunks of 1024 kept 2 threads half idle at 64x64). It depends on
+// the path count only, never on the threads, and the vertices and splats are concatenated in
+// path order whatever the chunk size: the images do not depend on it.
+constexpr uint64_t kMaxChunkPaths = 1024, kMinChunkPaths = 64, kMinChunks = 64;
+uint64_t chunk_paths_for(uint64_t light_paths) {
+  return std::clamp((light_paths + kMinChunks - 1) / kMinChunks, kMinChunkPaths, kMaxChunkPaths);
+}
 constexpr float kDefaultRadiusFactor = 0.003f;
 
 // Which techniques take part (tech. rep. section 6, SmallVCM's switches).
@@ -220,8 +227,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
     light_paths_ =
         settings_.bidir.light_paths > 0 ? settings_.bidir.light_paths : film.pixel_count();
     if (!settings_.bidir.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
-    const uint64_t chunks = (light_paths_ + kChunkPaths - 1) / kChunkPaths;
-    chunks_.resize(chunks);
+    chunk_paths_ = chunk_paths_for(light_paths_);
+    chunks_.resize((light_paths_ + chunk_paths_ - 1) / chunk_paths_);
+    chunk_offset_.resize(chunks_.size());
   }
 
   void render_iteration(const Scene& scene, uint32_t iteration, Film& film) override {
@@ -239,7 +247,12 @@ class BidirIntegrator final : public CameraPathIntegrator {
         bidir::LightPathAssignment(film.pixel_count(), light_paths_, iteration, settings_.seed);
 
     trace_light_paths(scene, it, film);
-    if (tech_.merge) grid_.build(vertices_, it.radius);
+    if (tech_.merge) {
+      const auto grid_start = std::chrono::steady_clock::now();
+      grid_.build(vertices_, it.radius);
+      grid_seconds_total_ +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - grid_start).count();
+    }
     current_ = it;
     trace_camera_paths(scene, iteration, film);
 
@@ -264,6 +277,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
     b["bytes_per_light_vertex"] = sizeof(LightVertex);
     b["light_vertex_buffer_bytes"] = vertices_.capacity() * sizeof(LightVertex);
     b["hash_grid_bytes"] = grid_.memory_bytes();
+    if (tech_.merge)
+      b["hash_grid_build_ms_per_iteration"] =
+          iterations_ ? 1e3 * grid_seconds_total_ / iterations_ : 0.0;
     b["radius_initial"] = base_radius_;
     b["radius_last"] = last_radius_;
     b["radius_alpha"] = settings_.bidir.radius_alpha;
@@ -284,8 +300,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
       chunk.path_ends.clear();
       chunk.splats.clear();
       chunk.nonfinite = 0;
-      const uint64_t first = c * kChunkPaths,
-                     last = std::min<uint64_t>(first + kChunkPaths, light_paths_);
+      const uint64_t first = c * chunk_paths_,
+                     last = std::min<uint64_t>(first + chunk_paths_, light_paths_);
       for (uint64_t path = first; path < last; ++path) {
         arena.reset();
         trace_light_path(scene, it, path, chunk, arena);
@@ -298,7 +314,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
     for (const LightChunk& c : chunks_) total += c.vertices.size();
     vertices_.resize(total);
     path_begin_.resize(light_paths_ + 1);
-    std::vector<size_t> chunk_offset(chunks_.size());
+    std::vector<size_t>& chunk_offset = chunk_offset_;
     for (size_t c = 0, offset = 0; c < chunks_.size(); ++c) {
       chunk_offset[c] = offset;
       offset += chunks_[c].vertices.size();
@@ -306,7 +322,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
     tbb::parallel_for(size_t(0), chunks_.size(), [&](size_t c) {
       const LightChunk& chunk = chunks_[c];
       std::copy(chunk.vertices.begin(), chunk.vertices.end(), vertices_.begin() + chunk_offset[c]);
-      const uint64_t first = c * kChunkPaths;
+      const uint64_t first = c * chunk_paths_;
       for (size_t i = 0; i < chunk.path_ends.size(); ++i) {
         path_begin_[first + i] = uint32_t(chunk_offset[c] + (i ? chunk.path_ends[i - 1] : 0));
       }
@@ -638,7 +654,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
   uint64_t light_paths_ = 0;
 
   // Per-iteration buffers, reused.
+  uint64_t chunk_paths_ = kMaxChunkPaths;  // light paths per chunk (chunk_paths_for)
   std::vector<LightChunk> chunks_;
+  std::vector<size_t> chunk_offset_;  // per chunk: its first vertex in vertices_
   std::vector<LightVertex> vertices_;
   std::vector<uint32_t> path_begin_;
   HashGrid grid_;
@@ -649,6 +667,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
   uint32_t iterations_ = 0;
   uint64_t vertices_total_ = 0;
   double seconds_total_ = 0;
+  double grid_seconds_total_ = 0;  // of seconds_total_, building the hash grid
   std::vector<std::string> technique_files_;
 };
 

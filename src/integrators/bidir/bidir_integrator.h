@@ -12,10 +12,11 @@
 //   bpm  merging at every camera vertex, MIS over merges (no connections).
 //   vcm  bpt + bpm with MIS over all (merge acceptance p_acc = pi r^2 per light path).
 //
-// Per iteration: N light subpaths (settings.bidir.light_paths, 0 = one per pixel) are traced in fixed
-// chunks of 1024, their non-delta vertices stored in 40 bytes each (light_vertex.h) and
-// concatenated in chunk order; light-tracing splats are recorded per chunk and applied in chunk
-// order; a hash grid over the vertices serves merging; then one camera subpath per pixel.
+// Per iteration: N light subpaths (settings.bidir.light_paths, 0 = one per pixel) are traced in
+// chunks whose size depends on N only (at most 1024 paths; at least 64 chunks when N allows),
+// their non-delta vertices stored in 40 bytes each (light_vertex.h) and concatenated in chunk
+// order; light-tracing splats are recorded per chunk and applied in chunk order; a hash grid
+// over the vertices serves merging; then one camera subpath per pixel.
 // Every random stream is keyed by (path or pixel, iteration, seed): images are bit-identical for
 // any thread count.
 //

@@ -3,6 +3,13 @@
 // visits the 2x2x2 cells that a ball of radius r around the point can touch (Georgiev's
 // SmallVCM grid, Teschner et al. 2003 hash). Two of those cells can hash to one bucket; each
 // bucket is visited once, so no vertex is ever counted twice.
+//
+// Speed (profiled on cornell-glass, vcm 512x512): a query scans whole buckets of which only a
+// few vertices lie within r, so the scan is the cost. The positions are therefore kept a second
+// time, sorted by bucket, each beside its vertex index in 16 bytes: the scan reads contiguous
+// memory instead of one 40-byte vertex per index, and the vertex is looked up only when it is
+// within r. The order in which fn sees the vertices is unchanged (bucket order, then vertex
+// order within a bucket), so the sums a query makes are too.
 #pragma once
 
 #include <algorithm>
@@ -39,16 +46,32 @@ class HashGrid {
     }
     for (int k = 0; k < count; ++k) {
       const uint32_t cell = buckets[k];
-      for (uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
-        const uint32_t index = indices_[i];
-        const Vec3 q = vertices[index].p();
-        if (distance_squared(p, q) <= radius2_) fn(index, q);
+      // Two passes over each batch: find the vertices within r and prefetch each one's record
+      // (the caller reads it: one cache miss per accepted vertex, which now overlap instead of
+      // following each other), then hand them to fn in the same order.
+      constexpr uint32_t kBatch = 32;
+      uint32_t found[kBatch];
+      for (uint32_t i = cell_start_[cell], end = cell_start_[cell + 1]; i < end;) {
+        uint32_t n = 0;
+        for (; i < end && n < kBatch; ++i) {
+          const Entry& e = entries_[i];
+          const Vec3 q(e.p[0], e.p[1], e.p[2]);
+          if (distance_squared(p, q) <= radius2_) {
+            __builtin_prefetch(&vertices[e.index]);
+            found[n++] = i;
+          }
+        }
+        for (uint32_t j = 0; j < n; ++j) {
+          const Entry& e = entries_[found[j]];
+          fn(e.index, Vec3(e.p[0], e.p[1], e.p[2]));
+        }
       }
     }
   }
 
   size_t memory_bytes() const {
-    return (cell_start_.capacity() + indices_.capacity()) * sizeof(uint32_t);
+    return (cell_start_.capacity() + cells_.capacity() + fill_.capacity()) * sizeof(uint32_t) +
+           entries_.capacity() * sizeof(Entry);
   }
 
  private:
@@ -72,8 +95,15 @@ class HashGrid {
   double inv_cell_ = 1;
   float radius2_ = 0;
   uint32_t table_size_ = 0;
-  std::vector<uint32_t> cell_start_;  // table_size_ + 1 offsets into indices_
-  std::vector<uint32_t> indices_;     // vertex indices sorted by cell
+  struct Entry {
+    float p[3];      // the vertex's position, exactly
+    uint32_t index;  // into the vertices the grid was built over
+  };
+  std::vector<uint32_t> cell_start_;  // table_size_ + 1 offsets into entries_
+  std::vector<Entry> entries_;        // sorted by bucket, in vertex order within one
+  // Build scratch, kept so that a build allocates nothing once the sizes have been reached.
+  std::vector<uint32_t> cells_;  // per vertex: its bucket
+  std::vector<uint32_t> fill_;   // per bucket: next free slot
 };
 
 }  // namespace caustica::bidir

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "lights/light_power.h"
 #include "lights/lights.h"
 
 namespace caustica::pbrt {
@@ -77,7 +78,7 @@ void add_light_source(const std::string& type, const ParamList& params, const So
   if (type == "point") {
     Rgb I = emission(params, "I", ctx);
     const float power = params.get_float("power", -1);
-    if (power > 0) I = scaled_by(params, "power", I, power / (4 * kPi));  // pbrt-v4: k_e = 4 pi
+    if (power > 0) I = scaled_by(params, "power", I, power / point_light_power_per_intensity());
     const Vec3 from = light_to_world.point(params.get_point3("from", {0, 0, 0}));
     if (!finite_vec(from)) throw SceneLoadError(where, "point light position is not finite");
     light = make_point_light(from, I);
@@ -90,9 +91,11 @@ void add_light_source(const std::string& type, const ParamList& params, const So
     if (from == to) throw SceneLoadError(where, "spot: \"from\" and \"to\" are the same point");
     const float power = params.get_float("power", -1);
     if (power > 0) {
-      // pbrt-v4 SpotLight::Create: the power of the smoothstep cone.
+      // The cone's cosines unclamped, as pbrt-v4 SpotLight::Create takes them. The light model
+      // clamps a falloff band wider than the cone (make_spot_light), so such a light does not
+      // emit exactly "power".
       const float cos_end = std::cos(radians(cone)), cos_start = std::cos(radians(cone - delta));
-      const float k_e = 2 * kPi * ((1 - cos_start) + (cos_start - cos_end) / 2);
+      const float k_e = spot_light_power_per_intensity(cos_start, cos_end);
       if (k_e > 0) I = scaled_by(params, "power", I, power / k_e);
     }
     const Vec3 p = light_to_world.point(from), dir = light_to_world.vector(to - from);

@@ -4,6 +4,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "lights/light_power.h"
 #include "materials/materials.h"
 
 namespace caustica::pbrt {
@@ -573,9 +574,11 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
       if (r.emission) {
         e.radiance = r.emission->radiance;
         e.two_sided = r.emission->two_sided;
-        if (r.emission->power > 0)
+        if (r.emission->power > 0) {
+          const float area = 4 * kPi * sqr(sphere.radius);
           e.radiance = e.radiance * (r.emission->power /
-                                     ((e.two_sided ? 2 : 1) * 4 * kPi * sqr(sphere.radius) * kPi));
+                                     diffuse_area_light_power_per_radiance(area, e.two_sided));
+        }
         check_area_emission(e.radiance, *r.emission);
       }
       builder_.add_sphere(sphere, m, r.emission ? &e : nullptr);
@@ -620,7 +623,8 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
     tri.reverse_orientation = mesh->reverse_orientation;
     const float area = tri.area(0);
     AreaEmission ei = e;
-    ei.radiance = area > 0 ? e.radiance * (r.emission->power / ((e.two_sided ? 2 : 1) * area * kPi))
+    ei.radiance = area > 0 ? e.radiance * (r.emission->power /
+                                           diffuse_area_light_power_per_radiance(area, e.two_sided))
                            : Rgb(0.f);
     check_area_emission(ei.radiance, *r.emission);
     builder_.add_mesh(std::move(tri), m, &ei);

@@ -149,7 +149,7 @@ void add_light_source(const std::string& type, const ParamList& params, const So
   } else if (type == "goniometric" || type == "projection") {
     ctx.warnings.warn(where, "light " + quote_excerpt(type) + " is not supported; skipped",
                       "light " + type);
-    for (const Param& p : params.all()) p.used = true;
+    params.mark_all_used();
     return;
   } else {
     throw SceneLoadError(

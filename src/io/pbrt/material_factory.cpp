@@ -217,7 +217,7 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
     ctx_.warnings.warn(
         where, "texture class " + quote_excerpt(cls) + " is not supported; using a constant 0.5",
         "texture " + cls);
-    for (const Param& p : params.all()) p.used = true;
+    params.mark_all_used();
     tex = make_constant_texture(Rgb(0.5f));
   } else {
     throw SceneLoadError(
@@ -376,7 +376,7 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
     TexturePtr r;
     if (type == "subsurface")
       r = spectrum_texture(params, "reflectance", std::nullopt, SpectrumKind::Albedo);
-    for (const Param& p : params.all()) p.used = true;
+    params.mark_all_used();
     m = make_diffuse(r ? r : make_constant_texture(Rgb(0.5f)));
   } else {
     throw SceneLoadError(where, "unknown material type " + quote_excerpt(type));

@@ -324,6 +324,10 @@ std::vector<Vec2> ParamList::get_point2s(std::string_view name) const {
   return out;
 }
 
+void ParamList::mark_all_used() const {
+  for (const Param& p : params_) p.used = true;
+}
+
 void ParamList::report_unused(Warnings& warnings, const std::string& context) const {
   for (const Param& p : params_)
     if (!p.used)

@@ -83,6 +83,9 @@ class ParamList {
   std::vector<Vec3> get_normals(std::string_view name) const;
   std::vector<Vec2> get_point2s(std::string_view name) const;
 
+  // Marks every parameter used: for a construct that is skipped or ignored as a whole, which
+  // warns once itself rather than once per parameter.
+  void mark_all_used() const;
   // Warns once per unused parameter name and `context` (for example "Shape \"sphere\"").
   void report_unused(Warnings& warnings, const std::string& context) const;
 

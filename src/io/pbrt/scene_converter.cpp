@@ -67,10 +67,6 @@ std::string integrator_name(const std::string& pbrt_name, const SourceLocation& 
   throw SceneLoadError(where, "unknown integrator " + quote_excerpt(pbrt_name));
 }
 
-void mark_all_used(const ParamList& params) {
-  for (const Param& p : params.all()) p.used = true;
-}
-
 }  // namespace
 
 SceneConverter::SceneConverter(SceneBuilder& builder, LoaderContext& ctx)
@@ -251,7 +247,7 @@ void SceneConverter::handle(const Directive& d) {
     if (d.args[0] != "perspective") {
       ctx_.warnings.warn(d.where, "camera " + quote_excerpt(d.args[0]) +
                                       " is not supported; using \"perspective\"");
-      mark_all_used(d.params);
+      d.params.mark_all_used();
     }
     camera_.fov_degrees = d.params.get_float("fov", 90);
     if (!(camera_.fov_degrees > 0 && camera_.fov_degrees < 180))
@@ -294,7 +290,7 @@ void SceneConverter::handle(const Directive& d) {
     const int spp = d.params.get_int("pixelsamples", 16);
     if (spp < 1) param_error(*d.params.find("pixelsamples"), "must be at least 1");
     builder_.settings().spp = spp;
-    mark_all_used(d.params);  // sampler-specific settings (seed, randomization) do not apply
+    d.params.mark_all_used();  // sampler-specific settings (seed, randomization) do not apply
     return;
   }
   if (n == "Integrator") {
@@ -334,7 +330,7 @@ void SceneConverter::handle(const Directive& d) {
   }
   if (n == "Accelerator") {
     require_world(d, false);
-    mark_all_used(d.params);  // Embree builds its own BVH
+    d.params.mark_all_used();  // Embree builds its own BVH
     return;
   }
   if (n == "ColorSpace") {
@@ -412,7 +408,7 @@ void SceneConverter::handle(const Directive& d) {
     ParamList params = with_attributes(d.params, "shape");
     if (const Param* alpha = params.find("alpha", {ParamType::Float, ParamType::Texture})) {
       if (alpha->type == ParamType::Float && alpha->numbers.size() == 1 && alpha->numbers[0] == 0) {
-        mark_all_used(params);
+        params.mark_all_used();
         return;  // fully transparent: pbrt-v4 drops such shapes too
       }
       ctx_.warnings.warn(alpha->where, "alpha masks are not supported; shapes are opaque", "alpha");
@@ -485,7 +481,7 @@ void SceneConverter::handle(const Directive& d) {
   if (n == "MakeNamedMedium" || n == "MediumInterface") {
     ctx_.warnings.warn(d.where, "participating media are not supported; " + n + " is ignored",
                        "media " + n);
-    mark_all_used(d.params);
+    d.params.mark_all_used();
     return;
   }
   throw SceneLoadError(d.where, "directive " + n + " is not handled");  // the parser knows no other

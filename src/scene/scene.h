@@ -104,8 +104,6 @@ class Scene {
   Bounds3 bounds_;
   SceneSettings settings_;
   std::string name_;
-
-  friend struct SceneAccess;
 };
 
 }  // namespace caustica

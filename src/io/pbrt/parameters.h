@@ -76,9 +76,7 @@ class ParamList {
   Vec3 get_vector3(std::string_view name, Vec3 def) const;
 
   // Arrays (empty if absent).
-  std::vector<float> get_floats(std::string_view name) const;
   std::vector<int> get_ints(std::string_view name) const;
-  std::vector<std::string> get_strings(std::string_view name) const;
   std::vector<Vec3> get_point3s(std::string_view name) const;
   std::vector<Vec3> get_normals(std::string_view name) const;
   std::vector<Vec2> get_point2s(std::string_view name) const;

@@ -20,7 +20,7 @@ TriangleMesh mesh_from(std::initializer_list<float> p) {
 
 MaterialPtr diffuse(Rgb c) { return make_diffuse(make_constant_texture(c)); }
 
-// The camera of shared/scenes/cornell-caustics.pbrt: `Scale -1 1 1` then LookAt, fov 45.
+// The camera of scenes/cornell-caustics.pbrt: `Scale -1 1 1` then LookAt, fov 45.
 CameraParams cornell_camera(int w, int h) {
   CameraParams c;
   const Transform world_to_camera =
@@ -37,34 +37,43 @@ CameraParams cornell_camera(int w, int h) {
 // The box of cornell-caustics.pbrt: white floor/ceiling/back, green left, red right, and the
 // light box on the ceiling with its one-sided emitting quad facing down (L = 25.0333).
 void add_cornell_box(SceneBuilder& b) {
-  const Rgb white(0.803922f), green(0.156863f, 0.803922f, 0.172549f), red(0.803922f, 0.152941f, 0.152941f);
-  b.add_mesh(mesh_from({-1.27029f, 1.30455f, -1.28002f, -1.27029f, -1.25549f, -1.28002f, 1.28975f, -1.25549f, -1.28002f,
-                        1.28975f,  -1.25549f, -1.28002f, 1.28975f,  1.30455f,  -1.28002f, -1.27029f, 1.30455f,  -1.28002f,
-                        -1.27029f, 1.30455f,  -1.28002f, 1.28975f,  1.30455f,  -1.28002f, 1.28975f,  1.30455f,  1.28002f,
-                        1.28975f,  1.30455f,  1.28002f,  -1.27029f, 1.30455f,  1.28002f,  -1.27029f, 1.30455f,  -1.28002f,
-                        1.28975f,  1.30455f,  1.28002f,  1.28975f,  -1.25549f, 1.28002f,  -1.27029f, -1.25549f, 1.28002f,
-                        -1.27029f, -1.25549f, 1.28002f,  -1.27029f, 1.30455f,  1.28002f,  1.28975f,  1.30455f,  1.28002f}),
+  const Rgb white(0.803922f), green(0.156863f, 0.803922f, 0.172549f),
+      red(0.803922f, 0.152941f, 0.152941f);
+  b.add_mesh(mesh_from({-1.27029f, 1.30455f,  -1.28002f, -1.27029f, -1.25549f, -1.28002f, 1.28975f,
+                        -1.25549f, -1.28002f, 1.28975f,  -1.25549f, -1.28002f, 1.28975f,  1.30455f,
+                        -1.28002f, -1.27029f, 1.30455f,  -1.28002f, -1.27029f, 1.30455f,  -1.28002f,
+                        1.28975f,  1.30455f,  -1.28002f, 1.28975f,  1.30455f,  1.28002f,  1.28975f,
+                        1.30455f,  1.28002f,  -1.27029f, 1.30455f,  1.28002f,  -1.27029f, 1.30455f,
+                        -1.28002f, 1.28975f,  1.30455f,  1.28002f,  1.28975f,  -1.25549f, 1.28002f,
+                        -1.27029f, -1.25549f, 1.28002f,  -1.27029f, -1.25549f, 1.28002f,  -1.27029f,
+                        1.30455f,  1.28002f,  1.28975f,  1.30455f,  1.28002f}),
              diffuse(white));
-  b.add_mesh(mesh_from({-1.27029f, 1.30455f, 1.28002f, -1.27029f, -1.25549f, 1.28002f, -1.27029f, -1.25549f, -1.28002f,
-                        -1.27029f, -1.25549f, -1.28002f, -1.27029f, 1.30455f, -1.28002f, -1.27029f, 1.30455f, 1.28002f}),
+  b.add_mesh(mesh_from({-1.27029f, 1.30455f, 1.28002f, -1.27029f, -1.25549f, 1.28002f, -1.27029f,
+                        -1.25549f, -1.28002f, -1.27029f, -1.25549f, -1.28002f, -1.27029f, 1.30455f,
+                        -1.28002f, -1.27029f, 1.30455f, 1.28002f}),
              diffuse(green));
-  b.add_mesh(mesh_from({1.28975f, 1.30455f, -1.28002f, 1.28975f, -1.25549f, -1.28002f, 1.28975f, -1.25549f, 1.28002f,
-                        1.28975f, -1.25549f, 1.28002f, 1.28975f, 1.30455f, 1.28002f, 1.28975f, 1.30455f, -1.28002f}),
+  b.add_mesh(mesh_from({1.28975f, 1.30455f, -1.28002f, 1.28975f, -1.25549f, -1.28002f, 1.28975f,
+                        -1.25549f, 1.28002f, 1.28975f, -1.25549f, 1.28002f, 1.28975f, 1.30455f,
+                        1.28002f, 1.28975f, 1.30455f, -1.28002f}),
              diffuse(red));
-  b.add_mesh(mesh_from({-0.25f, 0.25f,  1.26002f, 0.25f,  0.25f,  1.28002f, 0.25f,  0.25f,  1.26002f, 0.25f,  0.25f,  1.28002f,
-                        -0.25f, 0.25f,  1.26002f, -0.25f, 0.25f,  1.28002f, -0.25f, 0.25f,  1.28002f, -0.25f, -0.25f, 1.26002f,
-                        -0.25f, -0.25f, 1.28002f, -0.25f, -0.25f, 1.26002f, -0.25f, 0.25f,  1.28002f, -0.25f, 0.25f,  1.26002f,
-                        0.25f,  0.25f,  1.26002f, 0.25f,  -0.25f, 1.28002f, 0.25f,  -0.25f, 1.26002f, 0.25f,  -0.25f, 1.28002f,
-                        0.25f,  0.25f,  1.26002f, 0.25f,  0.25f,  1.28002f, -0.25f, -0.25f, 1.26002f, 0.25f,  -0.25f, 1.26002f,
-                        0.25f,  -0.25f, 1.28002f, 0.25f,  -0.25f, 1.28002f, -0.25f, -0.25f, 1.28002f, -0.25f, -0.25f, 1.26002f}),
-             diffuse(white));
+  b.add_mesh(
+      mesh_from({-0.25f, 0.25f,  1.26002f, 0.25f,  0.25f,  1.28002f, 0.25f,  0.25f,  1.26002f,
+                 0.25f,  0.25f,  1.28002f, -0.25f, 0.25f,  1.26002f, -0.25f, 0.25f,  1.28002f,
+                 -0.25f, 0.25f,  1.28002f, -0.25f, -0.25f, 1.26002f, -0.25f, -0.25f, 1.28002f,
+                 -0.25f, -0.25f, 1.26002f, -0.25f, 0.25f,  1.28002f, -0.25f, 0.25f,  1.26002f,
+                 0.25f,  0.25f,  1.26002f, 0.25f,  -0.25f, 1.28002f, 0.25f,  -0.25f, 1.26002f,
+                 0.25f,  -0.25f, 1.28002f, 0.25f,  0.25f,  1.26002f, 0.25f,  0.25f,  1.28002f,
+                 -0.25f, -0.25f, 1.26002f, 0.25f,  -0.25f, 1.26002f, 0.25f,  -0.25f, 1.28002f,
+                 0.25f,  -0.25f, 1.28002f, -0.25f, -0.25f, 1.28002f, -0.25f, -0.25f, 1.26002f}),
+      diffuse(white));
   const AreaEmission light{Rgb(25.0333f), false};
-  b.add_mesh(mesh_from({-0.25f, 0.25f, 1.26002f, 0.25f, -0.25f, 1.26002f, -0.25f, -0.25f, 1.26002f, 0.25f, -0.25f, 1.26002f,
-                        -0.25f, 0.25f, 1.26002f, 0.25f, 0.25f, 1.26002f}),
+  b.add_mesh(mesh_from({-0.25f, 0.25f, 1.26002f, 0.25f, -0.25f, 1.26002f, -0.25f, -0.25f, 1.26002f,
+                        0.25f, -0.25f, 1.26002f, -0.25f, 0.25f, 1.26002f, 0.25f, 0.25f, 1.26002f}),
              diffuse(Rgb(0.f)), &light);
 }
 
-constexpr Vec3 kLeftSphere(-0.53885f, 0.02453f, -0.78002f), kRightSphere(0.55831f, 0.02453f, -0.78002f);
+constexpr Vec3 kLeftSphere(-0.53885f, 0.02453f, -0.78002f),
+    kRightSphere(0.55831f, 0.02453f, -0.78002f);
 
 void finish_cornell(SceneBuilder& b, int w, int h) {
   b.set_camera(cornell_camera(w, h));
@@ -180,12 +189,15 @@ std::unique_ptr<Scene> make_furnace_scene(const FurnaceParams& params, int w, in
 
 std::vector<BuiltinSceneInfo> builtin_scenes() {
   return {
-      {"cornell-glass", "the default: Cornell box with a mirror and a glass sphere (= cornell-caustics.pbrt)"},
+      {"cornell-glass",
+       "the default: Cornell box with a mirror and a glass sphere (= cornell-caustics.pbrt)"},
       {"cornell", "Cornell box, diffuse only, area light"},
       {"cornell-glossy", "Cornell box with two rough metal spheres (no delta paths)"},
-      {"furnace", "camera inside a closed diffuse sphere, albedo 0.5, emitting 1: radiance is exactly 2"},
+      {"furnace",
+       "camera inside a closed diffuse sphere, albedo 0.5, emitting 1: radiance is exactly 2"},
       {"many-triangles", "Cornell box, floor a 1,002,528-triangle height field, glass sphere"},
-      {"env-furnace", "albedo-1 diffuse sphere under a uniform environment of radiance 1: every pixel is 1"},
+      {"env-furnace",
+       "albedo-1 diffuse sphere under a uniform environment of radiance 1: every pixel is 1"},
   };
 }
 

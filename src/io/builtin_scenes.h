@@ -1,5 +1,5 @@
 // Scenes built in code, reachable by name (`--scene NAME`). `cornell-glass` is the embedded
-// default and is identical to shared/scenes/cornell-caustics.pbrt.
+// default and is identical to scenes/cornell-caustics.pbrt.
 #pragma once
 
 #include <memory>
@@ -28,6 +28,7 @@ struct FurnaceParams {
   // Radiance everywhere inside: Le / (1 - albedo).
   float expected_radiance() const { return emission / (1.f - albedo); }
 };
-std::unique_ptr<Scene> make_furnace_scene(const FurnaceParams& params, int width = 32, int height = 32);
+std::unique_ptr<Scene> make_furnace_scene(const FurnaceParams& params, int width = 32,
+                                          int height = 32);
 
 }  // namespace caustica

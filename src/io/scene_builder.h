@@ -16,11 +16,14 @@ class SceneBuilder {
  public:
   // mesh must already be in world space. With emission, every triangle becomes an area light.
   void add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaEmission* emission = nullptr);
-  void add_sphere(const Sphere& sphere, MaterialPtr material, const AreaEmission* emission = nullptr);
+  void add_sphere(const Sphere& sphere, MaterialPtr material,
+                  const AreaEmission* emission = nullptr);
   void add_light(LightPtr light);
-  void set_camera(const CameraParams& camera) { data_.camera = camera; has_camera_ = true; }
+  void set_camera(const CameraParams& camera) {
+    data_.camera = camera;
+    has_camera_ = true;
+  }
   SceneSettings& settings() { return data_.settings; }
-  size_t light_count() const { return data_.lights.size(); }
 
   // Throws std::runtime_error if the scene has no camera resolution or is otherwise unusable.
   std::unique_ptr<Scene> build(const std::string& name);

@@ -10,6 +10,7 @@
 
 #include "core/frame.h"
 #include "core/warp.h"
+#include "lights/light_power.h"
 #include "lights/lights.h"
 
 namespace caustica {
@@ -47,8 +48,8 @@ float area_to_solid_angle(float inv_area, float dist2, float cos_light) {
 // The NEE record of a diffuse emitter: radiance L leaving p (oriented normal n) toward the
 // reference point along -wi, with its solid-angle density and the emission densities the
 // bidirectional core needs for MIS.
-std::optional<LightLiSample> diffuse_li_sample(Rgb L, Vec3 p, Vec3 n, Vec3 wi, float dist, float pdf_w,
-                                               float inv_area, bool two_sided) {
+std::optional<LightLiSample> diffuse_li_sample(Rgb L, Vec3 p, Vec3 n, Vec3 wi, float dist,
+                                               float pdf_w, float inv_area, bool two_sided) {
   if (!(pdf_w > 0) || !std::isfinite(pdf_w)) return std::nullopt;
   LightLiSample s;
   s.radiance = L;
@@ -76,7 +77,9 @@ class TriangleAreaLight final : public Light {
   }
 
   LightType type() const override { return LightType::Area; }
-  Rgb power() const override { return L_ * (area_ * kPi * (two_sided_ ? 2.f : 1.f)); }
+  Rgb power() const override {
+    return L_ * diffuse_area_light_power_per_radiance(area_, two_sided_);
+  }
 
   std::optional<LightLiSample> sample_li(Vec3 ref, Vec2 u) const override {
     if (area_ <= 0) return std::nullopt;
@@ -88,8 +91,8 @@ class TriangleAreaLight final : public Light {
     const Vec3 wi = d / dist;
     if (!emits_toward(-wi)) return std::nullopt;
     const float cos_light = abs_dot(n_, wi);
-    return diffuse_li_sample(L_, p, n_, wi, dist, area_to_solid_angle(inv_area_, dist2, cos_light), inv_area_,
-                             two_sided_);
+    return diffuse_li_sample(L_, p, n_, wi, dist, area_to_solid_angle(inv_area_, dist2, cos_light),
+                             inv_area_, two_sided_);
   }
 
   float pdf_li(Vec3 ref, Vec3 wi, Vec3 p_light, Vec3 n_light) const override {
@@ -146,7 +149,9 @@ class SphereAreaLight final : public Light {
   }
 
   LightType type() const override { return LightType::Area; }
-  Rgb power() const override { return L_ * (area_ * kPi * (two_sided_ ? 2.f : 1.f)); }
+  Rgb power() const override {
+    return L_ * diffuse_area_light_power_per_radiance(area_, two_sided_);
+  }
 
   std::optional<LightLiSample> sample_li(Vec3 ref, Vec2 u) const override {
     if (!(r_ > 0)) return std::nullopt;

@@ -9,6 +9,7 @@
 
 #include "core/frame.h"
 #include "core/warp.h"
+#include "lights/light_power.h"
 #include "lights/lights.h"
 
 namespace caustica {
@@ -20,7 +21,7 @@ class PointLight final : public Light {
   PointLight(Vec3 position, Rgb intensity) : p_(position), I_(intensity) {}
 
   LightType type() const override { return LightType::DeltaPosition; }
-  Rgb power() const override { return I_ * (4 * kPi); }
+  Rgb power() const override { return I_ * point_light_power_per_intensity(); }
 
   std::optional<LightLiSample> sample_li(Vec3 ref, Vec2 u) const override {
     (void)u;
@@ -79,10 +80,7 @@ class SpotLight final : public Light {
   }
 
   LightType type() const override { return LightType::DeltaPosition; }
-  // pbrt-v4 SpotLight::Phi: exact, since the smoothstep integrates to half its band in cos.
-  Rgb power() const override {
-    return I_ * (2 * kPi * ((1 - cos_start_) + (cos_start_ - cos_end_) / 2));
-  }
+  Rgb power() const override { return I_ * spot_light_power_per_intensity(cos_start_, cos_end_); }
 
   std::optional<LightLiSample> sample_li(Vec3 ref, Vec2 u) const override {
     (void)u;

@@ -113,8 +113,6 @@ class Scene {
   Bounds3 bounds_;
   SceneSettings settings_;
   std::string name_;
-
-  friend struct SceneAccess;
 };
 
 }  // namespace caustica

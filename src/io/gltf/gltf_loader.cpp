@@ -17,6 +17,7 @@
 #include "io/input_file.h"
 #include "io/pbrt/warnings.h"
 #include "io/scene_builder.h"
+#include "lights/light_power.h"
 #include "lights/lights.h"
 #include "materials/materials.h"
 
@@ -668,11 +669,12 @@ void GltfConverter::check_cameras_and_lights() const {
     for (double c : l.color)
       if (!in_range(c, 0, HUGE_VAL))
         fail(name + ".color: expected finite numbers >= 0, got " + format_number(c));
-    // The power of a point light is 4 pi I: that too must be a finite float.
+    // The power of a point light (a spot emits less) must be a finite float too.
+    const float per_intensity = point_light_power_per_intensity();
     for (double c : l.color)
-      if (!std::isfinite(float(c) * float(l.intensity) * 4 * kPi))
+      if (!std::isfinite(float(c) * float(l.intensity) * per_intensity))
         fail(name + ": color times intensity overflows to infinity");
-    if (!std::isfinite(float(l.intensity) * 4 * kPi))
+    if (!std::isfinite(float(l.intensity) * per_intensity))
       fail(name + ": intensity overflows to infinity");
     if (l.type == "spot") {
       const double outer = l.spot.outerConeAngle, inner = l.spot.innerConeAngle;

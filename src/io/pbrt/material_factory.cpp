@@ -217,7 +217,7 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
     ctx_.warnings.warn(
         where, "texture class " + quote_excerpt(cls) + " is not supported; using a constant 0.5",
         "texture " + cls);
-    for (const Param& p : params.all()) p.used = true;
+    params.mark_all_used();
     tex = make_constant_texture(Rgb(0.5f));
   } else {
     throw SceneLoadError(
@@ -227,49 +227,49 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
   table[name] = std::move(tex);
 }
 
+// Roughness from "uroughness" and "vroughness", each defaulting to "roughness" (names after
+// `prefix`), and "remaproughness"; both null for a constant zero: the smooth (delta) case.
+void MaterialFactory::roughness(const ParamList& params, const std::string& prefix, TexturePtr* u,
+                                TexturePtr* v, bool* remap) {
+  *u = float_texture(params, prefix + "uroughness", std::nullopt);
+  *v = float_texture(params, prefix + "vroughness", std::nullopt);
+  TexturePtr r = float_texture(params, prefix + "roughness", 0.f);
+  if (!*u) *u = r;
+  if (!*v) *v = r;
+  if (is_constant_value(*u, 0.f) && is_constant_value(*v, 0.f)) *u = *v = nullptr;
+  *remap = params.get_bool("remaproughness", true);
+}
+
+// "eta" as one positive index of refraction, 1.5 if absent.
+float MaterialFactory::eta(const ParamList& params) {
+  const Param* p = params.find(
+      "eta", {ParamType::Float, ParamType::Spectrum, ParamType::Rgb, ParamType::Texture});
+  float value = 1.5f;
+  if (p && p->type == ParamType::Float) {
+    if (p->numbers.size() != 1) param_error(*p, "expected one value");
+    value = float(p->numbers[0]);
+  } else if (p && p->type == ParamType::Texture) {
+    ctx_.warnings.warn(p->where, "textured eta is not supported; using 1.5", "textured eta");
+  } else if (p) {
+    // Spectrally varying IORs (dispersion) are reduced to one value.
+    value = spectrum_param_rgb(*p, SpectrumKind::Unbounded, ctx_).g;
+  }
+  if (!(value > 0)) param_error(*params.find("eta"), "eta must be positive");
+  return value;
+}
+
 MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamList& params,
                                            const SourceLocation& where,
                                            const NamedMaterialLookup& named) {
-  const std::string context = "Material " + quote_excerpt(type);
   if (params.find("displacement"))
     ctx_.warnings.warn(where, "material displacement is not supported; ignored", "displacement");
   if (params.find("normalmap"))
     ctx_.warnings.warn(where, "normal maps are not supported; ignored", "normalmap");
-
   const float kInf = std::numeric_limits<float>::infinity();
   // Negative roughness has no meaning (and its remapped alpha, sqrt(roughness), is NaN).
   for (const char* name : {"roughness", "uroughness", "vroughness", "conductor.roughness",
                            "conductor.uroughness", "conductor.vroughness"})
     check_constant_range(params, name, 0, kInf, "a roughness >= 0");
-  auto roughness = [&](TexturePtr* u, TexturePtr* v, bool* remap) {
-    *u = float_texture(params, "uroughness", std::nullopt);
-    *v = float_texture(params, "vroughness", std::nullopt);
-    TexturePtr r = float_texture(params, "roughness", 0.f);
-    if (!*u) *u = r;
-    if (!*v) *v = r;
-    // A constant zero roughness is the smooth (delta) case.
-    if (is_constant_value(*u, 0.f) && is_constant_value(*v, 0.f)) *u = *v = nullptr;
-    *remap = params.get_bool("remaproughness", true);
-  };
-  auto eta_value = [&](float def) {
-    const Param* p = params.find(
-        "eta", {ParamType::Float, ParamType::Spectrum, ParamType::Rgb, ParamType::Texture});
-    if (!p) return def;
-    if (p->type == ParamType::Float) {
-      if (p->numbers.size() != 1) param_error(*p, "expected one value");
-      return float(p->numbers[0]);
-    }
-    if (p->type == ParamType::Texture) {
-      ctx_.warnings.warn(p->where, "textured eta is not supported; using 1.5", "textured eta");
-      return 1.5f;
-    }
-    // Spectrally varying IORs (dispersion) are reduced to one value.
-    return spectrum_param_rgb(*p, SpectrumKind::Unbounded, ctx_).g;
-  };
-  auto check_eta = [&](float eta) {
-    if (!(eta > 0)) param_error(*params.find("eta"), "eta must be positive");
-    return eta;
-  };
 
   MaterialPtr m;
   if (type == "interface" || type.empty() || type == "none") {
@@ -277,98 +277,23 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
   } else if (type == "diffuse") {
     m = make_diffuse(spectrum_texture(params, "reflectance", Rgb(0.5f), SpectrumKind::Albedo));
   } else if (type == "conductor" || type == "coatedconductor") {
-    const std::string prefix = type == "coatedconductor" ? "conductor." : "";
-    if (type == "coatedconductor") {
-      ctx_.warnings.warn(
-          where,
-          "material \"coatedconductor\" is not supported; using its conductor without the coat",
-          "coatedconductor");
-      for (const Param& p : params.all())
-        if (p.name.rfind("interface.", 0) == 0 || p.name == "thickness" || p.name == "albedo" ||
-            p.name == "g" || p.name == "maxdepth" || p.name == "nsamples")
-          p.used = true;
-    }
-    ConductorParams c;
-    c.reflectance =
-        spectrum_texture(params, prefix + "reflectance", std::nullopt, SpectrumKind::Albedo);
-    c.eta = spectrum_texture(params, prefix + "eta", std::nullopt, SpectrumKind::Unbounded);
-    c.k = spectrum_texture(params, prefix + "k", std::nullopt, SpectrumKind::Unbounded);
-    if (c.reflectance && (c.eta || c.k))
-      throw SceneLoadError(where,
-                           type + ": \"reflectance\" cannot be combined with \"eta\" or \"k\"");
-    if (!c.reflectance) {
-      if (!c.eta)
-        c.eta =
-            make_constant_texture(named_spectrum("metal-Cu-eta").value_or(Rgb(0.2f, 0.92f, 1.1f)));
-      if (!c.k)
-        c.k = make_constant_texture(named_spectrum("metal-Cu-k").value_or(Rgb(3.9f, 2.45f, 2.14f)));
-    }
-    if (type == "coatedconductor") {
-      c.u_roughness = float_texture(params, "conductor.uroughness", std::nullopt);
-      c.v_roughness = float_texture(params, "conductor.vroughness", std::nullopt);
-      TexturePtr r = float_texture(params, "conductor.roughness", 0.f);
-      if (!c.u_roughness) c.u_roughness = r;
-      if (!c.v_roughness) c.v_roughness = r;
-      if (is_constant_value(c.u_roughness, 0.f) && is_constant_value(c.v_roughness, 0.f))
-        c.u_roughness = c.v_roughness = nullptr;
-      c.remap_roughness = params.get_bool("remaproughness", true);
-    } else {
-      roughness(&c.u_roughness, &c.v_roughness, &c.remap_roughness);
-    }
-    if (!c.u_roughness && c.reflectance && is_constant_value(c.reflectance, 1.f))
-      m = make_mirror(Rgb(1.f));  // pbrt-v4's conductor with reflectance 1 is a perfect mirror
-    else
-      m = make_conductor(c);
+    m = conductor(type, params, where);
   } else if (type == "dielectric") {
     DielectricParams d;
-    d.eta = check_eta(eta_value(1.5f));
-    roughness(&d.u_roughness, &d.v_roughness, &d.remap_roughness);
+    d.eta = eta(params);
+    roughness(params, "", &d.u_roughness, &d.v_roughness, &d.remap_roughness);
     m = make_dielectric(d);
   } else if (type == "thindielectric") {
-    m = make_thin_dielectric(check_eta(eta_value(1.5f)));
+    m = make_thin_dielectric(eta(params));
   } else if (type == "coateddiffuse") {
-    CoatedDiffuseParams c;
-    c.reflectance = spectrum_texture(params, "reflectance", Rgb(0.5f), SpectrumKind::Albedo);
-    roughness(&c.u_roughness, &c.v_roughness, &c.remap_roughness);
-    if (!c.u_roughness) c.u_roughness = c.v_roughness = make_constant_texture(Rgb(0.f));
-    const Param* tp = params.find("thickness", {ParamType::Float, ParamType::Texture});
-    if (tp && tp->type == ParamType::Texture)
-      ctx_.warnings.warn(tp->where, "textured coating thickness is not supported; using 0.01",
-                         "textured thickness");
-    else
-      c.thickness = params.get_float("thickness", 0.01f);
-    c.eta = check_eta(eta_value(1.5f));
-    c.albedo = spectrum_texture(params, "albedo", Rgb(0.f), SpectrumKind::Albedo);
-    c.g = float_texture(params, "g", 0.f);
-    c.max_depth = params.get_int("maxdepth", 10);
-    c.n_samples = params.get_int("nsamples", 1);
-    if (c.max_depth < 1 || c.n_samples < 1 || c.max_depth > 1000 || c.n_samples > 1000)
-      throw SceneLoadError(where,
-                           "coateddiffuse: maxdepth and nsamples must be between 1 and 1000");
-    m = make_coated_diffuse(c);
+    m = coated_diffuse(params, where);
   } else if (type == "diffusetransmission") {
     m = make_diffuse_transmission(
         spectrum_texture(params, "reflectance", Rgb(0.25f), SpectrumKind::Albedo),
         spectrum_texture(params, "transmittance", Rgb(0.25f), SpectrumKind::Albedo),
         params.get_float("scale", 1));
   } else if (type == "mix") {
-    const Param* mp = params.find("materials", {ParamType::String});
-    if (!mp || mp->strings.size() != 2)
-      throw SceneLoadError(mp ? mp->where : where,
-                           "mix: \"string materials\" must name exactly two materials");
-    MaterialPtr a = named(mp->strings[0], mp->where), b = named(mp->strings[1], mp->where);
-    // The amount is the probability of choosing the second material.
-    check_constant_range(params, "amount", 0, 1, "an amount between 0 and 1");
-    TexturePtr amount = float_texture(params, "amount", 0.5f);
-    if (!a && !b)
-      m = nullptr;
-    else if (!a || !b) {
-      ctx_.warnings.warn(
-          where, "mix with an interface material is not supported; using the other material");
-      m = a ? a : b;
-    } else {
-      m = make_mix(a, b, amount);
-    }
+    m = mix(params, where, named);
   } else if (type == "measured" || type == "hair" || type == "subsurface") {
     ctx_.warnings.warn(where,
                        "material " + quote_excerpt(type) + " is not supported; using diffuse",
@@ -376,13 +301,88 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
     TexturePtr r;
     if (type == "subsurface")
       r = spectrum_texture(params, "reflectance", std::nullopt, SpectrumKind::Albedo);
-    for (const Param& p : params.all()) p.used = true;
+    params.mark_all_used();
     m = make_diffuse(r ? r : make_constant_texture(Rgb(0.5f)));
   } else {
     throw SceneLoadError(where, "unknown material type " + quote_excerpt(type));
   }
-  params.report_unused(ctx_.warnings, context);
+  params.report_unused(ctx_.warnings, "Material " + quote_excerpt(type));
   return m;
+}
+
+// "conductor", or "coatedconductor" reduced to its conductor (parameters "conductor.*").
+MaterialPtr MaterialFactory::conductor(const std::string& type, const ParamList& params,
+                                       const SourceLocation& where) {
+  const std::string prefix = type == "coatedconductor" ? "conductor." : "";
+  if (type == "coatedconductor") {
+    ctx_.warnings.warn(
+        where,
+        "material \"coatedconductor\" is not supported; using its conductor without the coat",
+        "coatedconductor");
+    for (const Param& p : params.all())
+      if (p.name.rfind("interface.", 0) == 0 || p.name == "thickness" || p.name == "albedo" ||
+          p.name == "g" || p.name == "maxdepth" || p.name == "nsamples")
+        p.used = true;
+  }
+  ConductorParams c;
+  c.reflectance =
+      spectrum_texture(params, prefix + "reflectance", std::nullopt, SpectrumKind::Albedo);
+  c.eta = spectrum_texture(params, prefix + "eta", std::nullopt, SpectrumKind::Unbounded);
+  c.k = spectrum_texture(params, prefix + "k", std::nullopt, SpectrumKind::Unbounded);
+  if (c.reflectance && (c.eta || c.k))
+    throw SceneLoadError(where,
+                         type + ": \"reflectance\" cannot be combined with \"eta\" or \"k\"");
+  if (!c.reflectance) {
+    if (!c.eta)
+      c.eta =
+          make_constant_texture(named_spectrum("metal-Cu-eta").value_or(Rgb(0.2f, 0.92f, 1.1f)));
+    if (!c.k)
+      c.k = make_constant_texture(named_spectrum("metal-Cu-k").value_or(Rgb(3.9f, 2.45f, 2.14f)));
+  }
+  roughness(params, prefix, &c.u_roughness, &c.v_roughness, &c.remap_roughness);
+  if (!c.u_roughness && c.reflectance && is_constant_value(c.reflectance, 1.f))
+    return make_mirror(Rgb(1.f));  // pbrt-v4's conductor with reflectance 1 is a perfect mirror
+  return make_conductor(c);
+}
+
+MaterialPtr MaterialFactory::coated_diffuse(const ParamList& params, const SourceLocation& where) {
+  CoatedDiffuseParams c;
+  c.reflectance = spectrum_texture(params, "reflectance", Rgb(0.5f), SpectrumKind::Albedo);
+  roughness(params, "", &c.u_roughness, &c.v_roughness, &c.remap_roughness);
+  if (!c.u_roughness) c.u_roughness = c.v_roughness = make_constant_texture(Rgb(0.f));
+  const Param* tp = params.find("thickness", {ParamType::Float, ParamType::Texture});
+  if (tp && tp->type == ParamType::Texture)
+    ctx_.warnings.warn(tp->where, "textured coating thickness is not supported; using 0.01",
+                       "textured thickness");
+  else
+    c.thickness = params.get_float("thickness", 0.01f);
+  c.eta = eta(params);
+  c.albedo = spectrum_texture(params, "albedo", Rgb(0.f), SpectrumKind::Albedo);
+  c.g = float_texture(params, "g", 0.f);
+  c.max_depth = params.get_int("maxdepth", 10);
+  c.n_samples = params.get_int("nsamples", 1);
+  if (c.max_depth < 1 || c.n_samples < 1 || c.max_depth > 1000 || c.n_samples > 1000)
+    throw SceneLoadError(where, "coateddiffuse: maxdepth and nsamples must be between 1 and 1000");
+  return make_coated_diffuse(c);
+}
+
+MaterialPtr MaterialFactory::mix(const ParamList& params, const SourceLocation& where,
+                                 const NamedMaterialLookup& named) {
+  const Param* mp = params.find("materials", {ParamType::String});
+  if (!mp || mp->strings.size() != 2)
+    throw SceneLoadError(mp ? mp->where : where,
+                         "mix: \"string materials\" must name exactly two materials");
+  MaterialPtr a = named(mp->strings[0], mp->where), b = named(mp->strings[1], mp->where);
+  // The amount is the probability of choosing the second material.
+  check_constant_range(params, "amount", 0, 1, "an amount between 0 and 1");
+  TexturePtr amount = float_texture(params, "amount", 0.5f);
+  if (!a && !b) return nullptr;
+  if (!a || !b) {
+    ctx_.warnings.warn(where,
+                       "mix with an interface material is not supported; using the other material");
+    return a ? a : b;
+  }
+  return make_mix(a, b, amount);
 }
 
 }  // namespace caustica::pbrt

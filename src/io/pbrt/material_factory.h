@@ -16,12 +16,12 @@
 #include <optional>
 #include <string>
 
+#include "geometry/texture.h"
 #include "image/image.h"
 #include "io/pbrt/context.h"
 #include "io/pbrt/parameters.h"
 #include "io/pbrt/spectrum_param.h"
 #include "materials/material.h"
-#include "geometry/texture.h"
 
 namespace caustica::pbrt {
 
@@ -52,6 +52,14 @@ class MaterialFactory {
   std::shared_ptr<const Image> load_image(const std::string& path, bool srgb, const Param& where);
 
  private:
+  void roughness(const ParamList& params, const std::string& prefix, TexturePtr* u, TexturePtr* v,
+                 bool* remap);
+  float eta(const ParamList& params);
+  MaterialPtr conductor(const std::string& type, const ParamList& params,
+                        const SourceLocation& where);
+  MaterialPtr coated_diffuse(const ParamList& params, const SourceLocation& where);
+  MaterialPtr mix(const ParamList& params, const SourceLocation& where,
+                  const NamedMaterialLookup& named);
   TexturePtr texture_param(const ParamList& params, const std::string& name, bool is_float,
                            Rgb def);
 

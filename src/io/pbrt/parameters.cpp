@@ -285,21 +285,11 @@ Vec3 ParamList::get_vector3(std::string_view name, Vec3 def) const {
   return p ? Vec3(float(p->numbers[0]), float(p->numbers[1]), float(p->numbers[2])) : def;
 }
 
-std::vector<float> ParamList::get_floats(std::string_view name) const {
-  std::vector<float> out;
-  if (const Param* p = find(name, {ParamType::Float}))
-    for (double d : p->numbers) out.push_back(float(d));
-  return out;
-}
 std::vector<int> ParamList::get_ints(std::string_view name) const {
   std::vector<int> out;
   if (const Param* p = find(name, {ParamType::Integer}))
     for (double d : p->numbers) out.push_back(int(d));
   return out;
-}
-std::vector<std::string> ParamList::get_strings(std::string_view name) const {
-  const Param* p = find(name, {ParamType::String});
-  return p ? p->strings : std::vector<std::string>{};
 }
 namespace {
 std::vector<Vec3> triples(const Param* p) {
@@ -322,6 +312,10 @@ std::vector<Vec2> ParamList::get_point2s(std::string_view name) const {
     for (size_t i = 0; i + 1 < p->numbers.size(); i += 2)
       out.emplace_back(float(p->numbers[i]), float(p->numbers[i + 1]));
   return out;
+}
+
+void ParamList::mark_all_used() const {
+  for (const Param& p : params_) p.used = true;
 }
 
 void ParamList::report_unused(Warnings& warnings, const std::string& context) const {

@@ -76,13 +76,14 @@ class ParamList {
   Vec3 get_vector3(std::string_view name, Vec3 def) const;
 
   // Arrays (empty if absent).
-  std::vector<float> get_floats(std::string_view name) const;
   std::vector<int> get_ints(std::string_view name) const;
-  std::vector<std::string> get_strings(std::string_view name) const;
   std::vector<Vec3> get_point3s(std::string_view name) const;
   std::vector<Vec3> get_normals(std::string_view name) const;
   std::vector<Vec2> get_point2s(std::string_view name) const;
 
+  // Marks every parameter used: for a construct that is skipped or ignored as a whole, which
+  // warns once itself rather than once per parameter.
+  void mark_all_used() const;
   // Warns once per unused parameter name and `context` (for example "Shape \"sphere\"").
   void report_unused(Warnings& warnings, const std::string& context) const;
 

@@ -213,8 +213,6 @@ void parse_impl(Tokenizer& tokens, DirectiveHandler& handler, const ParseOptions
 
 }  // namespace
 
-bool is_directive(const std::string& name) { return find_grammar(name) != nullptr; }
-
 void parse_directives(Tokenizer& tokens, DirectiveHandler& handler, const ParseOptions& options) {
   parse_impl(tokens, handler, options, 0);
 }

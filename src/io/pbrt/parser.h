@@ -40,7 +40,4 @@ struct ParseOptions {
 // Parses the whole token stream. Throws SceneLoadError at the first syntax error.
 void parse_directives(Tokenizer& tokens, DirectiveHandler& handler, const ParseOptions& options);
 
-// True if `name` is a pbrt-v4 directive this parser knows.
-bool is_directive(const std::string& name);
-
 }  // namespace caustica::pbrt

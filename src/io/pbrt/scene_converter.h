@@ -6,12 +6,18 @@
 // Materials are created after the whole file is read, as in pbrt-v4, so NamedMaterial may
 // refer to a material defined later. Object instances (ObjectBegin/End/ObjectInstance) are
 // flattened into world-space copies for now rather than Embree instances.
+//
+// Each directive has one handler; a table (scene_converter.cpp) maps directive names to them and
+// says where each is allowed. The handlers live by meaning in scene_converter_state.cpp
+// (transformations, blocks, attributes), _options.cpp (Camera, Film, Sampler, ...), _world.cpp
+// (materials, textures, lights, shapes, objects); _shapes.cpp hands the shapes to the builder.
 #pragma once
 
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "io/pbrt/context.h"
@@ -63,14 +69,67 @@ class SceneConverter final : public DirectiveHandler {
     SourceLocation where;
   };
 
-  void handle(const Directive& d);
-  void apply_transform(const Directive& d, const Transform& t, bool concatenate);
+  using Handler = void (SceneConverter::*)(const Directive&);
+  enum class Scope { Anywhere, Options, World };  // Options: before WorldBegin; World: after
+  struct DirectiveEntry {
+    std::string_view name;
+    Handler handle;
+    Scope scope;
+  };
+  static const DirectiveEntry* find_directive(std::string_view name);
+
+  // Graphics state (scene_converter_state.cpp).
+  void identity(const Directive& d);
+  void translate(const Directive& d);
+  void scale(const Directive& d);
+  void rotate(const Directive& d);
+  void look_at(const Directive& d);
+  void transform_matrix(const Directive& d);  // Transform and ConcatTransform
+  void coordinate_system(const Directive& d);
+  void coord_sys_transform(const Directive& d);
+  void active_transform(const Directive& d);
+  void transform_times(const Directive& d);
+  void reverse_orientation(const Directive& d);
+  void begin_block(const Directive& d);  // AttributeBegin and TransformBegin
+  void end_block(const Directive& d);    // AttributeEnd and TransformEnd
+  void attribute(const Directive& d);
+  void apply_transform(const Transform& t, bool concatenate);
+
+  // Options block (scene_converter_options.cpp).
+  void camera(const Directive& d);
+  void film(const Directive& d);
+  void sampler(const Directive& d);
+  void integrator(const Directive& d);
+  void pixel_filter(const Directive& d);
+  void accelerator(const Directive& d);
+  void color_space(const Directive& d);
+  void option(const Directive& d);
+  void world_begin(const Directive& d);
+  void world_end(const Directive& d);
+
+  // World block (scene_converter_world.cpp).
+  void material_directive(const Directive& d);
+  void make_named_material(const Directive& d);
+  void named_material_directive(const Directive& d);
+  void texture(const Directive& d);
+  void light_source(const Directive& d);
+  void area_light_source(const Directive& d);
+  void shape(const Directive& d);
+  void object_begin(const Directive& d);
+  void object_end(const Directive& d);
+  void object_instance(const Directive& d);
+  void media(const Directive& d);  // MakeNamedMedium and MediumInterface
+  MaterialPtr material(const MaterialRef& ref);
+  MaterialPtr named_material(const std::string& name, const SourceLocation& where);
+
   void require_world(const Directive& d, bool inside) const;
   ParamList with_attributes(const ParamList& params, const std::string& target) const;
   void add_shape_record(ShapeRecord record);
-  MaterialPtr material(const MaterialRef& ref);
-  MaterialPtr named_material(const std::string& name, const SourceLocation& where);
+
+  // Handing shapes to the builder (scene_converter_shapes.cpp).
   void emit_shape(const ShapeRecord& record);
+  void emit_sphere(const ShapeRecord& record, const Sphere& sphere, const MaterialPtr& m);
+  void emit_mesh(const ShapeRecord& record, TriangleMesh mesh, bool quadric, const MaterialPtr& m);
 
   SceneBuilder& builder_;
   LoaderContext& ctx_;

@@ -230,7 +230,7 @@ std::optional<ShapeGeometry> make_shape(const std::string& type, const ParamList
              type == "hyperboloid" || type == "nurbs" || type == "heightfield") {
     ctx.warnings.warn(where, "shape " + quote_excerpt(type) + " is not supported; skipped",
                       "shape " + type);
-    for (const Param& p : params.all()) p.used = true;
+    params.mark_all_used();
     return std::nullopt;
   } else {
     throw SceneLoadError(where, "unknown shape " + quote_excerpt(type) +

@@ -6,7 +6,6 @@
 
 #include <memory>
 #include <string>
-#include <string_view>
 
 #include "io/load_error.h"
 
@@ -17,8 +16,6 @@ struct Token {
   Kind kind = Kind::End;
   std::string text;  // strings: the unescaped contents, without quotes
   int line = 0, column = 0;
-
-  bool is_word(std::string_view w) const { return kind == Kind::Word && text == w; }
 };
 
 // Short description of a token for error messages: "[" or "\"abc\"" or "end of file".

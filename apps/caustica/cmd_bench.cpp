@@ -116,7 +116,7 @@ Runner add_bench_command(CLI::App& app) {
                   "Rays per raw Embree measurement (default 2^20)");
   cmd->add_option("--json", opts->json, "Also write the results as JSON to this file");
   cmd->add_flag("--quiet,-q", opts->quiet, "No progress bar");
-  return [opts, checks] { return run_bench_command(*opts, *checks); };
+  return [opts, checks](Ranks&) { return run_bench_command(*opts, *checks); };
 }
 
 }  // namespace caustica::cli

@@ -14,6 +14,7 @@
 #include "integrators/registry.h"
 #include "interrupt.h"
 #include "preflight.h"
+#include "ranks_cli.h"
 #include "render/output.h"
 #include "render/progress.h"
 #include "render/renderer.h"
@@ -37,24 +38,29 @@ namespace {
 struct ReferenceOptions : SharedOptions {
   std::string integrator = "pt";
   std::string outfile;
+  double checkpoint_seconds = 60;
 };
 
-int run_reference(const ReferenceOptions& o, const CheckedOptions& checks) {
-  if (!checks.check()) return 2;
-  if (!check_name("integrator", o.integrator, integrator_names())) return 2;
-  const std::string out =
-      o.outfile.empty() ? std::filesystem::path(o.scene).stem().string() + "-ref" : o.outfile;
-  const OutputPaths paths = output_paths_for(out);
-  {
-    FileSection probing;  // the writability probe creates a file
-    if (std::string problem = output_problem(paths); !problem.empty()) {
-      print_error("--outfile: " + problem);
-      return 2;
-    }
-  }
+int run_reference(const ReferenceOptions& o, const CheckedOptions& checks, Ranks& ranks) {
+  OutputPaths paths;
   std::unique_ptr<Scene> scene;
   IntegratorSettings settings;
-  if (int rc = load_configured_scene(o, &scene, &settings)) return rc;
+  const int prepared = prepare_on_all_ranks(ranks, [&] {
+    if (!checks.check()) return 2;
+    if (!check_name("integrator", o.integrator, integrator_names())) return 2;
+    const std::string out =
+        o.outfile.empty() ? std::filesystem::path(o.scene).stem().string() + "-ref" : o.outfile;
+    paths = output_paths_for(out);
+    if (ranks.is_root()) {  // only rank 0 writes
+      FileSection probing;  // the writability probe creates a file
+      if (std::string problem = output_problem(paths); !problem.empty()) {
+        print_error("--outfile: " + problem);
+        return 2;
+      }
+    }
+    return load_configured_scene(o, &scene, &settings);
+  });
+  if (prepared != 0) return prepared;
   const int threads = o.threads > 0 ? o.threads : tbb::info::default_concurrency();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
   auto integrator = make_integrator(o.integrator, settings);
@@ -63,8 +69,21 @@ int run_reference(const ReferenceOptions& o, const CheckedOptions& checks) {
   RenderCallbacks cb;
   cb.progress_label = "reference " + o.integrator;
   cb.stop = stop_flag();
+  cb.ranks = &ranks;
+  if (ranks.size() > 1) {
+    cb.checkpoint_seconds = o.checkpoint_seconds;
+    cb.on_checkpoint = [&](const Image& image, uint32_t iterations, double seconds) {
+      const nlohmann::json partial = {{"kind", "reference"}, {"checkpoint", true},
+                                      {"scene", o.scene},    {"integrator", o.integrator},
+                                      {"seconds", seconds},  {"iterations", iterations},
+                                      {"seed", o.seed},      {"ranks", ranks.size()}};
+      FileSection writing;
+      write_render_outputs(image, partial, paths, 0.f);
+    };
+  }
   arm_graceful_stop();
   const RenderResult r = render(*scene, *integrator, budget, cb);
+  if (!ranks.is_root()) return exit_code_after_signals(0);  // rank 0 writes
   RunDescription run;
   run.scene = o.scene;
   run.integrator = o.integrator;
@@ -90,7 +109,24 @@ struct CompareOptions : SharedOptions {
   double reference_seconds = 0;
 };
 
-int run_compare(const CompareOptions& o, const CheckedOptions& checks) {
+int run_compare(const CompareOptions& o, const CheckedOptions& checks, Ranks& ranks) {
+  // Under mpirun rank 0 runs the whole comparison; the other ranks check their options (so that
+  // a bad one ends all of them with one message) and then wait, sleeping, for rank 0.
+  if (ranks.size() > 1) {
+    int rc = prepare_on_all_ranks(ranks, [&] { return checks.check() ? 0 : 2; });
+    if (rc != 0) return rc;
+    if (!ranks.is_root()) {
+      arm_graceful_stop();  // a signal must not end this rank while rank 0 writes the report
+      ranks.wait_all();
+      return exit_code_after_signals(0);
+    }
+    std::fprintf(stderr, "compare: runs on rank 0 only; the other %d ranks wait\n",
+                 ranks.size() - 1);
+    SingleProcess alone;
+    rc = run_compare(o, checks, alone);
+    ranks.wait_all();
+    return rc;
+  }
   if (!checks.check()) return 2;
   std::vector<std::string> names = split_list(o.integrators);
   if (names.empty()) {
@@ -223,7 +259,10 @@ Runner add_reference_command(CLI::App& app) {
   cmd->add_option("--outfile", o->outfile,
                   "Output name (default SCENE-ref): NAME.exr, NAME.png, NAME.json; its folder must "
                   "exist and be writable");
-  return [o, checks] { return run_reference(*o, *checks); };
+  checks->number("--checkpoint", &o->checkpoint_seconds, 0, kMaxSeconds, false,
+                 "Under mpirun with several ranks: every this many seconds combine the ranks' "
+                 "images and write the outputs (default 60; 0: only at the end)");
+  return [o, checks](Ranks& ranks) { return run_reference(*o, *checks, ranks); };
 }
 
 Runner add_compare_command(CLI::App& app) {
@@ -247,7 +286,7 @@ Runner add_compare_command(CLI::App& app) {
                  "Seconds for the reference render (default 4x --time; at most 30 days)");
   cmd->add_option("--out", o->out_dir,
                   "Output directory (default SCENE-compare), created if missing");
-  return [o, checks] { return run_compare(*o, *checks); };
+  return [o, checks](Ranks& ranks) { return run_compare(*o, *checks, ranks); };
 }
 
 }  // namespace caustica::cli

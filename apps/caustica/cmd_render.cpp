@@ -15,6 +15,7 @@
 #include "io/builtin_scenes.h"
 #include "io/scene_loader.h"
 #include "preflight.h"
+#include "ranks_cli.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "render/statistics.h"
@@ -32,45 +33,67 @@ struct RenderOptions : SharedOptions {
   std::string outfile = "caustica.exr";
   float exposure = 0;
   bool quiet = false;
+  double checkpoint_seconds = 60;
 };
 
-int run_render(const RenderOptions& o, const CheckedOptions& checks) {
-  if (!checks.check()) return 2;
-  if (!o.scene_positional.empty() && !o.scene_flag.empty() && o.scene_positional != o.scene_flag) {
-    print_error("give the scene once (positional or --scene)");
-    return 2;
-  }
-  std::string scene_name = !o.scene_flag.empty() ? o.scene_flag : o.scene_positional;
-  if (scene_name.empty()) scene_name = default_scene_name();
-  if (!o.integrator.empty() && !check_name("integrator", o.integrator, integrator_names()))
-    return 2;
-  SceneSetup setup = o;  // the shared part of the options
-  setup.scene = scene_name;
+std::string iso_time_now() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+int run_render(const RenderOptions& o, const CheckedOptions& checks, Ranks& ranks) {
+  std::string scene_name;
   const OutputPaths paths = output_paths_for(o.outfile);
-  {
-    FileSection probing;  // the writability probes create a file
-    if (std::string problem = output_problem(paths); !problem.empty()) {
-      print_error("--outfile: " + problem);
-      return 2;
-    }
-    if (!o.bidir.techniques_dir.empty())
-      if (std::string problem = output_dir_problem(o.bidir.techniques_dir); !problem.empty()) {
-        print_error("--techniques: " + problem);
-        return 2;
-      }
-  }
   std::unique_ptr<Scene> scene;
   IntegratorSettings settings;
   double load_seconds = 0;
-  if (int rc = load_configured_scene(setup, &scene, &settings, &load_seconds)) return rc;
+  std::string integrator_name;
+  std::unique_ptr<Integrator> integrator;
+  const int prepared = prepare_on_all_ranks(ranks, [&] {
+    if (!checks.check()) return 2;
+    if (!o.scene_positional.empty() && !o.scene_flag.empty() &&
+        o.scene_positional != o.scene_flag) {
+      print_error("give the scene once (positional or --scene)");
+      return 2;
+    }
+    scene_name = !o.scene_flag.empty() ? o.scene_flag : o.scene_positional;
+    if (scene_name.empty()) scene_name = default_scene_name();
+    if (!o.integrator.empty() && !check_name("integrator", o.integrator, integrator_names()))
+      return 2;
+    if (ranks.size() > 1 && !o.bidir.techniques_dir.empty()) {
+      print_error(
+          "--techniques writes the images of one process's iterations; it is not "
+          "supported with more than one MPI rank");
+      return 2;
+    }
+    SceneSetup setup = o;  // the shared part of the options
+    setup.scene = scene_name;
+    if (ranks.is_root()) {  // only rank 0 writes
+      FileSection probing;  // the writability probes create a file
+      if (std::string problem = output_problem(paths); !problem.empty()) {
+        print_error("--outfile: " + problem);
+        return 2;
+      }
+      if (!o.bidir.techniques_dir.empty())
+        if (std::string problem = output_dir_problem(o.bidir.techniques_dir); !problem.empty()) {
+          print_error("--techniques: " + problem);
+          return 2;
+        }
+    }
+    if (int rc = load_configured_scene(setup, &scene, &settings, &load_seconds)) return rc;
 
-  std::string integrator_name = o.integrator;
-  if (integrator_name.empty()) {  // the scene file's (the loader maps pbrt-v4's names), else pt
-    integrator_name = "pt";
-    for (const auto& n : integrator_names())
-      if (n == scene->settings().integrator) integrator_name = n;
-  }
-  auto integrator = make_integrator(integrator_name, settings);
+    integrator_name = o.integrator;
+    if (integrator_name.empty()) {  // the scene file's (the loader maps pbrt-v4's names), else pt
+      integrator_name = "pt";
+      for (const auto& n : integrator_names())
+        if (n == scene->settings().integrator) integrator_name = n;
+    }
+    integrator = make_integrator(integrator_name, settings);
+    return 0;
+  });
+  if (prepared != 0) return prepared;
 
   RenderBudget budget;
   budget.spp = o.spp;
@@ -84,17 +107,47 @@ int run_render(const RenderOptions& o, const CheckedOptions& checks) {
   callbacks.quiet = o.quiet;
   callbacks.progress_label = integrator_name;
   callbacks.stop = stop_flag();
+  callbacks.ranks = &ranks;
+  nlohmann::json stats;
+  if (ranks.size() > 1) {
+    callbacks.checkpoint_seconds = o.checkpoint_seconds;
+    callbacks.on_checkpoint = [&](const Image& image, uint32_t iterations, double seconds) {
+      nlohmann::json partial = {{"scene", scene_name},   {"integrator", integrator_name},
+                                {"checkpoint", true},    {"iterations", iterations},
+                                {"spp", iterations},     {"seconds", seconds},
+                                {"ranks", ranks.size()}, {"threads_per_rank", threads},
+                                {"seed", o.seed},        {"finished_at", iso_time_now()}};
+      FileSection writing;
+      write_render_outputs(image, partial, paths, o.exposure);
+    };
+  }
   arm_graceful_stop();
   const RenderResult result = render(*scene, *integrator, budget, callbacks);
+  if (!ranks.is_root()) return exit_code_after_signals(0);  // rank 0 writes
 
-  RunDescription run;
-  run.scene = scene_name;
-  run.integrator = integrator_name;
-  run.settings = settings;
-  run.threads = threads;
-  run.time_budget = o.seconds;
-  run.scene_load_seconds = load_seconds;
-  const nlohmann::json stats = render_statistics(*scene, *integrator, result, run);
+  stats["scene"] = scene_name;
+  stats["integrator"] = integrator_name;
+  stats["resolution"] = {scene->camera().width(), scene->camera().height()};
+  stats["iterations"] = result.iterations;
+  stats["interrupted"] = result.interrupted;
+  stats["spp"] = result.iterations;
+  stats["seconds"] = result.seconds;
+  stats["scene_load_seconds"] = load_seconds;
+  stats["rays"] = result.rays;
+  stats["rays_per_second"] = result.seconds > 0 ? double(result.rays) / result.seconds : 0.0;
+  stats["nonfinite_samples_discarded"] = result.nonfinite;
+  stats["peak_memory_mb"] = double(peak_memory_bytes()) / (1024 * 1024);
+  stats["threads"] = threads;  // per rank
+  stats["ranks"] = result.ranks;
+  // What each rank sends in the film reduction: 3 channels x 16-byte fixed-point sums.
+  stats["film_reduce_bytes_per_rank"] =
+      result.ranks > 1 ? 48.0 * scene->camera().width() * scene->camera().height() : 0.0;
+  stats["seed"] = o.seed;
+  stats["max_depth"] = settings.max_depth;
+  stats["mis"] = o.mis.empty() ? "default" : o.mis;
+  stats["time_budget_seconds"] = o.seconds;
+  stats["finished_at"] = iso_time_now();
+  integrator->report(stats);
 
   {
     FileSection writing;
@@ -140,7 +193,11 @@ Runner add_render_command(CLI::App& app) {
   checks->number("--exposure", &opts->exposure, -64, 64, false,
                  "PNG exposure in stops, -64..64 (EXR is never tone mapped)");
   cmd->add_flag("--quiet,-q", opts->quiet, "No progress bar or summary");
-  return [opts, checks] { return run_render(*opts, *checks); };
+  checks->number("--checkpoint", &opts->checkpoint_seconds, 0, kMaxSeconds, false,
+                 "Under mpirun with several ranks: every this many seconds combine the ranks' "
+                 "images and write the outputs, so that a killed run leaves one (default 60; 0: "
+                 "only at the end)");
+  return [opts, checks](Ranks& ranks) { return run_render(*opts, *checks, ranks); };
 }
 
 std::string integrator_help() {
@@ -152,7 +209,7 @@ std::string integrator_help() {
 
 Runner add_integrators_command(CLI::App& app) {
   app.add_subcommand("integrators", "List the integrators, what each is, and its capabilities");
-  return [] {
+  return [](Ranks&) {
     for (const IntegratorInfo& info : integrator_registry())
       std::printf("%-5s %-11s %-15s %-12s %s\n", info.name.c_str(),
                   info.unbiased ? "unbiased" : "consistent",
@@ -166,7 +223,8 @@ Runner add_integrators_command(CLI::App& app) {
 Runner add_scenes_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("scenes", "List the built-in scenes");
   (void)cmd;
-  return [] {
+  return [](Ranks& ranks) {
+    if (!ranks.is_root()) return 0;  // one list under mpirun
     for (const auto& s : builtin_scenes())
       std::printf("%-16s %s\n", s.name.c_str(), s.description.c_str());
     return 0;

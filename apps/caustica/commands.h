@@ -1,13 +1,16 @@
 // Subcommands of the `caustica` binary. Each registers its options on the CLI11 app and
-// returns the process exit code when run: 0 success, 1 runtime failure, 2 bad input.
+// returns the process exit code when run: 0 success, 1 runtime failure, 2 bad input. Under
+// mpirun every rank runs the command; only rank 0 writes files and prints progress.
 #pragma once
 
 #include <CLI/CLI.hpp>
 #include <functional>
 
+#include "render/ranks.h"
+
 namespace caustica::cli {
 
-using Runner = std::function<int()>;
+using Runner = std::function<int(Ranks& ranks)>;
 
 Runner add_render_command(CLI::App& app);
 Runner add_scenes_command(CLI::App& app);

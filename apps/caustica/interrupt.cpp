@@ -13,6 +13,7 @@ namespace {
 // All state the handler touches: lock-free atomics only (std::atomic<int/bool> are on every
 // platform we build for; the static_asserts say so), no locks, no allocation.
 std::atomic<bool> graceful{false};
+std::atomic<bool> messages{true};
 std::atomic<bool> stop{false};
 std::atomic<int> first_signal{0};
 std::atomic<int> signals_seen{0};
@@ -48,8 +49,10 @@ void on_signal(int sig) {
   if (graceful.load()) {
     if (!repeat) {
       stop.store(true);
-      say("\ncaustica: interrupted; finishing this iteration and writing the image (again to quit "
-          "at once)\n");
+      if (messages.load())
+        say("\ncaustica: interrupted; finishing this iteration and writing the image (again to "
+            "quit "
+            "at once)\n");
       return;
     }
     // 0: the first signal's handler, in another thread, has not stored its time yet.
@@ -81,6 +84,8 @@ void install_interrupt_handler() {
     sigaction(sig, &action, nullptr);
   }
 }
+
+void set_interrupt_messages(bool enabled) { messages.store(enabled); }
 
 void arm_graceful_stop() { graceful.store(true); }
 

@@ -25,6 +25,9 @@ inline constexpr const char* kInterruptHelp =
 // thread sees it), except for a signal that was ignored when the process started.
 void install_interrupt_handler();
 
+// Under mpirun a signal usually reaches every rank; only rank 0 says it was interrupted.
+void set_interrupt_messages(bool enabled);
+
 // From now on the first signal asks the render to stop instead of quitting.
 void arm_graceful_stop();
 

@@ -10,9 +10,10 @@
 
 namespace caustica::cli {
 
-// Bytes per pixel: film sums (3 doubles, 24), the averaged image (12), light-tracing splats
+// Bytes per pixel: film sums (3 doubles for the iteration, 24, and 3 16-byte fixed-point totals,
+// 48; film.h), the averaged image (12), light-tracing splats
 // (12), the tone-mapped copy (12), PNG bytes (~6) and the EXR encoding (12, its worst case).
-constexpr uint64_t kFilmBytesPerPixel = 80;
+constexpr uint64_t kFilmBytesPerPixel = 128;
 // Bytes per light path: its start index (4), its end within a chunk (4) and at least one
 // stored 32-byte light vertex.
 constexpr uint64_t kBytesPerLightPath = 40;

@@ -1,8 +1,17 @@
 #include "film/film.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <stdexcept>
+
 namespace caustica {
 
-Film::Film(int width, int height) : width_(width), height_(height), sum_(3 * size_t(width) * size_t(height), 0.0) {}
+Film::Film(int width, int height)
+    : width_(width),
+      height_(height),
+      current_(3 * size_t(width) * size_t(height), 0.0),
+      total_(3 * size_t(width) * size_t(height), FixedSum(0)) {}
 
 void Film::add_image(const Image& image, float scale) {
   for (size_t i = 0; i < pixel_count(); ++i) {
@@ -11,17 +20,38 @@ void Film::add_image(const Image& image, float scale) {
       count_nonfinite();
       continue;
     }
-    sum_[3 * i] += v.r;
-    sum_[3 * i + 1] += v.g;
-    sum_[3 * i + 2] += v.b;
+    current_[3 * i] += v.r;
+    current_[3 * i + 1] += v.g;
+    current_[3 * i + 2] += v.b;
   }
+}
+
+void Film::end_iteration() {
+  // Each element is independent, so the split over threads cannot change a result.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, current_.size(), 1 << 14),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i != r.end(); ++i) {
+                        total_[i] += to_fixed(current_[i]);
+                        current_[i] = 0.0;
+                      }
+                    });
+  ++iterations_;
+}
+
+void Film::add(const Film& other) {
+  if (other.width_ != width_ || other.height_ != height_)
+    throw std::invalid_argument("Film::add: films differ in size");
+  for (size_t i = 0; i < total_.size(); ++i) total_[i] += other.total_[i];
+  iterations_ += other.iterations_;
+  nonfinite_.fetch_add(other.nonfinite_count());
 }
 
 Image Film::image() const {
   Image out(width_, height_);
   const double inv = iterations_ > 0 ? 1.0 / iterations_ : 0.0;
   for (size_t i = 0; i < pixel_count(); ++i)
-    out[i] = Rgb(float(sum_[3 * i] * inv), float(sum_[3 * i + 1] * inv), float(sum_[3 * i + 2] * inv));
+    out[i] = Rgb(float(from_fixed(total_[3 * i]) * inv), float(from_fixed(total_[3 * i + 1]) * inv),
+                 float(from_fixed(total_[3 * i + 2]) * inv));
   return out;
 }
 

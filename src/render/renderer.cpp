@@ -3,10 +3,12 @@
 #include <sys/resource.h>
 
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 #include "film/film.h"
 #include "render/progress.h"
+#include "render/ranks.h"
 #include "scene/scene.h"
 
 namespace caustica {
@@ -21,8 +23,11 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
                     const RenderCallbacks& callbacks) {
   if (budget.spp <= 0 && budget.seconds <= 0)
     throw std::invalid_argument("render budget needs spp or seconds");
+  SingleProcess single;
+  Ranks& ranks = callbacks.ranks ? *callbacks.ranks : single;
+  const uint64_t rank_count = uint64_t(ranks.size()), me = uint64_t(ranks.rank());
   Film film(scene.camera().width(), scene.camera().height());
-  ProgressBar progress(callbacks.progress_label, callbacks.quiet);
+  ProgressBar progress(callbacks.progress_label, callbacks.quiet || !ranks.is_root());
   const auto start = std::chrono::steady_clock::now();
   const uint64_t rays_before = scene.rays_traced();
   double paused = 0;  // seconds spent in callbacks, not counted as render time
@@ -31,44 +36,100 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
   };
 
   integrator.prepare(scene, film);
-  bool interrupted = false;
-  for (uint32_t it = 0;; ++it) {
-    if (budget.spp > 0 && it >= uint32_t(budget.spp)) break;
-    if (budget.seconds > 0 && it > 0 && elapsed() >= budget.seconds) break;
-    // After the budget checks, so a stop that arrives during the last iteration is not
-    // reported as an interruption of a render that was complete anyway.
-    if (it > 0 && callbacks.stop && callbacks.stop->load()) {
-      interrupted = true;
-      break;
+  uint32_t done = 0;         // iterations this rank completed
+  bool finished = false;     // this rank has no more work
+  bool interrupted = false;  // ... because of a stop
+  bool stop_all = false;     // a stop was agreed in a round: the same on every rank
+  bool round_pending = false;
+  RoundState totals;
+  double next_checkpoint = callbacks.checkpoint_seconds;
+  auto my_state = [&] {
+    RoundState s;
+    s.iterations = done;
+    s.rays = scene.rays_traced() - rays_before;
+    s.finished = finished;
+    s.stop = callbacks.stop && callbacks.stop->load();
+    s.interrupted = interrupted;
+    s.root_micros = ranks.is_root() ? uint64_t(std::max(0.0, elapsed()) * 1e6) : 0;
+    return s;
+  };
+  for (;;) {
+    // Progress rounds: one at a time, started when the last one ended. In one process a round
+    // ends at once, so the stop flag is read before every iteration as it always was.
+    if (!round_pending) {
+      ranks.start_round(my_state());
+      round_pending = true;
     }
-    integrator.render_iteration(scene, it, film);
+    // A finished rank waits for the round; a working one only looks and renders on.
+    if (ranks.poll_round(&totals, finished)) {
+      round_pending = false;
+      stop_all = stop_all || totals.stop > 0;
+      if (totals.finished == rank_count) break;
+      const double root_seconds = double(totals.root_micros) * 1e-6;
+      const double frac_spp = budget.spp > 0 ? double(totals.iterations) / budget.spp : 0;
+      const double frac_time = budget.seconds > 0 ? root_seconds / budget.seconds : 0;
+      progress.update(std::max(frac_spp, frac_time),
+                      root_seconds > 0 ? double(totals.rays) / root_seconds * 1e-6 : 0, "Mrays/s");
+      // Every rank sees the same round totals, so every rank takes this branch at the same
+      // round and the collective inside it matches.
+      if (next_checkpoint > 0 && root_seconds >= next_checkpoint && totals.iterations > 0) {
+        const auto before = std::chrono::steady_clock::now();
+        Film sum(film.width(), film.height());
+        ranks.sum_films(film, &sum);
+        if (ranks.is_root() && callbacks.on_checkpoint)
+          callbacks.on_checkpoint(sum.image(), sum.iterations(), root_seconds);
+        next_checkpoint = callbacks.checkpoint_seconds *
+                          (std::floor(root_seconds / callbacks.checkpoint_seconds) + 1);
+        paused += std::chrono::duration<double>(std::chrono::steady_clock::now() - before).count();
+      }
+    }
+    if (finished) continue;
+
+    // Iterations are dealt round-robin by their global index, which keys the random streams and
+    // the merge radius schedule exactly as in one process.
+    const uint64_t iteration = me + uint64_t(done) * rank_count;
+    if (budget.spp > 0 && iteration >= uint64_t(budget.spp)) {
+      finished = true;
+    } else if (budget.seconds > 0 && done > 0 && elapsed() >= budget.seconds) {
+      finished = true;
+    } else if (done > 0 && stop_all) {
+      // After the budget checks, so a stop that arrives during the last iteration is not
+      // reported as an interruption of a render that was complete anyway.
+      finished = interrupted = true;
+    }
+    if (finished) continue;
+    integrator.render_iteration(scene, uint32_t(iteration), film);
     film.end_iteration();
-    const double t = elapsed();
-    const double frac_spp = budget.spp > 0 ? double(it + 1) / budget.spp : 0;
-    const double frac_time = budget.seconds > 0 ? t / budget.seconds : 0;
-    const double mrays = t > 0 ? double(scene.rays_traced() - rays_before) / t * 1e-6 : 0;
-    progress.update(std::max(frac_spp, frac_time), mrays, "Mrays/s");
+    ++done;
     if (callbacks.on_iteration) {
       const auto before = std::chrono::steady_clock::now();
-      const bool go_on = callbacks.on_iteration(film, it + 1, t);
+      const bool go_on = callbacks.on_iteration(film, done, elapsed());
       paused += std::chrono::duration<double>(std::chrono::steady_clock::now() - before).count();
-      if (!go_on) break;
+      if (!go_on) finished = true;
     }
   }
   integrator.finish(scene, film);
   const double total = elapsed();
-  if (!interrupted)
-    progress.update(1.0, total > 0 ? double(scene.rays_traced() - rays_before) / total * 1e-6 : 0,
-                    "Mrays/s");
+  if (totals.interrupted == 0)
+    progress.update(1.0, total > 0 ? double(totals.rays) / total * 1e-6 : 0, "Mrays/s");
   progress.finish();
 
   RenderResult r;
-  r.seconds = elapsed();
-  r.image = film.image();
-  r.iterations = film.iterations();
-  r.rays = scene.rays_traced() - rays_before;
-  r.nonfinite = film.nonfinite_count();
-  r.interrupted = interrupted;
+  r.seconds = total;
+  r.ranks = ranks.size();
+  r.local_iterations = done;
+  r.iterations = uint32_t(totals.iterations);
+  r.rays = totals.rays;
+  r.interrupted = totals.interrupted > 0;
+  if (rank_count == 1) {
+    r.image = film.image();
+    r.nonfinite = film.nonfinite_count();
+  } else {
+    Film sum(film.width(), film.height());
+    ranks.sum_films(film, &sum);
+    r.image = sum.image();
+    r.nonfinite = sum.nonfinite_count();
+  }
   return r;
 }
 

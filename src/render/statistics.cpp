@@ -30,7 +30,11 @@ nlohmann::json render_statistics(const Scene& scene, const Integrator& integrato
   s["rays_per_second"] = r.seconds > 0 ? double(r.rays) / r.seconds : 0.0;
   s["nonfinite_samples_discarded"] = r.nonfinite;
   s["peak_memory_mb"] = double(peak_memory_bytes()) / (1024 * 1024);
-  s["threads"] = run.threads;
+  s["threads"] = run.threads;  // per rank
+  s["ranks"] = r.ranks;
+  // What each rank sends in the film reduction: 3 channels x 16-byte fixed-point sums.
+  s["film_reduce_bytes_per_rank"] =
+      r.ranks > 1 ? 48.0 * scene.camera().width() * scene.camera().height() : 0.0;
   s["seed"] = run.settings.seed;
   s["max_depth"] = run.settings.max_depth;
   s["mis"] = !run.settings.mis                          ? "default"

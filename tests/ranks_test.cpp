@@ -1,0 +1,125 @@
+// The accumulation that makes a render split over MPI ranks bit-identical to one process
+// (film/fixed_sum.h, film.h) and the render loop's dealing of iterations (render/ranks.h),
+// checked without MPI.
+#include "render/ranks.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <vector>
+
+#include "film/film.h"
+#include "io/builtin_scenes.h"
+#include "test_scenes.h"
+
+namespace caustica {
+namespace {
+
+TEST(FixedSum, ConvertsExactlyAboveTheResolutionAndClampsTheRange) {
+  for (double v : {0.1, -0.1, 1234.5678, 1.0 / 4096, -3e5})
+    EXPECT_EQ(from_fixed(to_fixed(v)), v) << v;
+  EXPECT_EQ(from_fixed(to_fixed(1e12)), kFixedSumMaxValue);
+  EXPECT_EQ(from_fixed(to_fixed(-1e12)), -kFixedSumMaxValue);
+  // Below 2^-64 nothing is left; above it, the error is under 2^-64.
+  EXPECT_EQ(to_fixed(1e-20), FixedSum(0));
+  EXPECT_NEAR(from_fixed(to_fixed(1e-15)), 1e-15, 0x1p-64);
+}
+
+// Values of many magnitudes, where double addition in two groupings gives two answers.
+std::vector<double> awkward_values() {
+  std::vector<double> v;
+  uint64_t state = 12345;
+  for (int i = 0; i < 64; ++i) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    const double u = double(state >> 11) * 0x1p-53;
+    v.push_back((i % 3 == 0 ? 1e5 : 1e-3) * u);
+  }
+  return v;
+}
+
+TEST(FilmSum, IterationsSplitOverTwoFilmsSumBitIdenticallyToOneFilm) {
+  const std::vector<double> values = awkward_values();
+  Film one(1, 1), even(1, 1), odd(1, 1);
+  double sequential = 0, sum_even = 0, sum_odd = 0;
+  for (size_t i = 0; i < values.size(); ++i) {
+    const Rgb v(float(values[i]), float(values[i] * 0.5), float(-values[i]));
+    one.add_sample(0, 0, v);
+    one.end_iteration();
+    Film& part = i % 2 ? odd : even;
+    part.add_sample(0, 0, v);
+    part.end_iteration();
+    sequential += float(values[i]);
+    (i % 2 ? sum_odd : sum_even) += float(values[i]);
+  }
+  // The data must be able to tell the schemes apart: plain doubles give two answers.
+  ASSERT_NE(sequential, sum_even + sum_odd);
+  Film total(1, 1);
+  total.add(odd);  // the order of the parts does not matter either
+  total.add(even);
+  EXPECT_EQ(total.iterations(), one.iterations());
+  for (int c = 0; c < 3; ++c) EXPECT_TRUE(total.sums()[c] == one.sums()[c]) << c;
+  EXPECT_EQ(total.image()[0], one.image()[0]);
+}
+
+TEST(FilmSum, RejectsAFilmOfAnotherSize) {
+  Film a(2, 2), b(2, 3);
+  EXPECT_THROW(a.add(b), std::invalid_argument);
+}
+
+// Rank `rank` of `size`, alone: its rounds report that the others finish when it does, and
+// its film goes to the test instead of a reduction.
+class PretendRank final : public Ranks {
+ public:
+  PretendRank(int rank, int size, Film* film_out) : rank_(rank), size_(size), out_(film_out) {}
+  int rank() const override { return rank_; }
+  int size() const override { return size_; }
+  void start_round(const RoundState& mine) override { round_ = mine; }
+  bool poll_round(RoundState* totals, bool) override {
+    *totals = round_;
+    totals->finished *= uint64_t(size_);
+    return true;
+  }
+  void sum_films(const Film& mine, Film*) override { out_->add(mine); }
+  int agree(int status, const std::string&, std::string* message) override {
+    message->clear();
+    return status;
+  }
+  void wait_all() override {}
+  [[noreturn]] void abort(int code) override { std::_Exit(code); }
+
+ private:
+  int rank_, size_;
+  Film* out_;
+  RoundState round_;
+};
+
+TEST(RanksRender, TwoRanksIterationsGiveTheOneProcessImageBitForBit) {
+  auto scene = make_builtin_scene("cornell-glass", 24, 20);
+  for (const char* name : {"pt", "bpt", "vcm", "ppm"}) {
+    IntegratorSettings settings;
+    settings.seed = 7;
+    const RenderResult single = test::render_with(*scene, name, 5, settings);
+    Film total(24, 20);
+    uint32_t iterations[2] = {0, 0};
+    for (int rank = 0; rank < 2; ++rank) {
+      PretendRank pretend(rank, 2, &total);
+      auto integrator = make_integrator(name, settings);
+      RenderBudget budget;
+      budget.spp = 5;
+      RenderCallbacks cb;
+      cb.quiet = true;
+      cb.ranks = &pretend;
+      iterations[rank] = render(*scene, *integrator, budget, cb).local_iterations;
+    }
+    EXPECT_EQ(iterations[0], 3u) << name;  // iterations 0, 2, 4
+    EXPECT_EQ(iterations[1], 2u) << name;  // iterations 1, 3
+    const Image image = total.image();
+    size_t differing = 0;
+    for (size_t i = 0; i < image.pixel_count(); ++i)
+      if (!(image[i] == single.image[i])) ++differing;
+    EXPECT_EQ(differing, 0u) << name;
+  }
+}
+
+}  // namespace
+}  // namespace caustica

@@ -1,6 +1,7 @@
 // Microbenchmarks of the hot kernels (Google Benchmark). Build with
 //   cmake -S . -B build-bench -G Ninja -DCMAKE_BUILD_TYPE=Release -DCAUSTICA_BUILD_BENCH=ON
-//   ninja -C build-bench caustica_bench && build-bench/bench/caustica_bench --benchmark_repetitions=5
+//   ninja -C build-bench caustica_bench && build-bench/bench/caustica_bench
+//   --benchmark_repetitions=5
 // Google Benchmark prints the machine (CPUs, caches, load) with the results; report medians.
 #include <benchmark/benchmark.h>
 
@@ -98,7 +99,8 @@ void BM_IntersectIncoherent(benchmark::State& state) {
   const Frame f = Frame::from_normal(si.ng);
   for (auto _ : state) {
     SurfaceInteraction out;
-    benchmark::DoNotOptimize(scene.intersect(si.spawn_ray(f.to_world(sample_cosine_hemisphere(rng.next_2d()))), &out));
+    benchmark::DoNotOptimize(
+        scene.intersect(si.spawn_ray(f.to_world(sample_cosine_hemisphere(rng.next_2d()))), &out));
   }
   state.SetItemsProcessed(state.iterations());
 }

@@ -5,8 +5,9 @@
 #  2. the whole suite on the Release build (build/). Its CTest summary is the last output.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-# chromium: the HTML report is tested in a headless browser.
-"$root/scripts/install-deps.sh" chromium
+# chromium: the HTML report is tested in a headless browser; clang-format and git: the tree's
+# formatting is a test (Format.TreeIsClangFormatClean).
+"$root/scripts/install-deps.sh" chromium clang-format git
 jobs="$(nproc)"
 if [[ "${CAUSTICA_SANITIZERS:-1}" != 0 ]]; then
   cmake -S "$root" -B "$root/build-asan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCAUSTICA_SANITIZE=ON >/dev/null

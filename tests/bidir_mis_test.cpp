@@ -9,6 +9,7 @@
 #include <random>
 
 #include "core/rng.h"
+#include "geometry/texture.h"
 #include "image/image.h"
 #include "integrators/bidir/light_vertex.h"
 #include "integrators/bidir/path_weights.h"
@@ -21,7 +22,6 @@
 #include "materials/material.h"
 #include "materials/materials.h"
 #include "scene/scene.h"
-#include "geometry/texture.h"
 
 using namespace caustica;
 using namespace caustica::bidir;

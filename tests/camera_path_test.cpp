@@ -1,9 +1,10 @@
 // The camera-path seam with a test double: a complete integrator is its estimate() alone. This
 // one returns the emission the camera ray sees directly, through the seam's pixel loop, streams,
 // filter and film, and the vertex helpers' emitter enumeration.
+#include "integrators/camera_path.h"
+
 #include <gtest/gtest.h>
 
-#include "integrators/camera_path.h"
 #include "integrators/path_vertex.h"
 #include "io/builtin_scenes.h"
 #include "render/renderer.h"

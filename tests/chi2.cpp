@@ -79,7 +79,8 @@ Chi2Result chi2_test(const std::function<std::optional<DirectionSample>(Pcg32&)>
     // The pdf a sample reports must equal pdf() for the same direction.
     const float p = pdf(w);
     if (std::abs(p - s->pdf) > 1e-3f * std::max(1.f, std::max(p, s->pdf)) && pdf_mismatch++ < 3)
-      diag << "sample pdf " << s->pdf << " != pdf() " << p << " at (" << w.x << "," << w.y << "," << w.z << "); ";
+      diag << "sample pdf " << s->pdf << " != pdf() " << p << " at (" << w.x << "," << w.y << ","
+           << w.z << "); ";
   }
   res.sampled_mass = double(ok) / o.sample_count;
   // Expected counts: integrate the pdf over each cell with a sub-grid.
@@ -92,7 +93,8 @@ Chi2Result chi2_test(const std::function<std::optional<DirectionSample>(Pcg32&)>
       double acc = 0;
       for (int a = 0; a < sub; ++a)
         for (int b = 0; b < sub; ++b)
-          acc += pdf(dir_from_cell(z0 + (a + 0.5) * (z1 - z0) / sub, p0 + (b + 0.5) * (p1 - p0) / sub));
+          acc += pdf(
+              dir_from_cell(z0 + (a + 0.5) * (z1 - z0) / sub, p0 + (b + 0.5) * (p1 - p0) / sub));
       const double integral = acc * (z1 - z0) * (p1 - p0) / (sub * sub);
       expected[size_t(ti) * np + pi] = integral * o.sample_count;
       total += integral;
@@ -101,7 +103,8 @@ Chi2Result chi2_test(const std::function<std::optional<DirectionSample>(Pcg32&)>
   // Pool low-expectation cells (sorted by expectation) so the chi-square approximation holds.
   std::vector<size_t> order(expected.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return expected[a] < expected[b]; });
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return expected[a] < expected[b]; });
   double pooled_obs = 0, pooled_exp = 0, chsq = 0;
   int dof = 0;
   for (size_t idx : order) {

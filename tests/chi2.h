@@ -14,8 +14,8 @@
 namespace caustica::test {
 
 struct DirectionSample {
-  Vec3 w;       // unit direction (any frame, as long as pdf() uses the same)
-  float pdf;    // what the sampler reports for w
+  Vec3 w;     // unit direction (any frame, as long as pdf() uses the same)
+  float pdf;  // what the sampler reports for w
 };
 
 struct Chi2Result {
@@ -23,9 +23,9 @@ struct Chi2Result {
   double p_value = 0;
   double statistic = 0;
   int dof = 0;
-  double sampled_mass = 0;   // fraction of samples that succeeded
-  double pdf_integral = 0;   // integral of pdf over the sphere (should be <= 1)
-  std::string message;       // diagnostics when failing
+  double sampled_mass = 0;  // fraction of samples that succeeded
+  double pdf_integral = 0;  // integral of pdf over the sphere (should be <= 1)
+  std::string message;      // diagnostics when failing
 };
 
 struct Chi2Options {
@@ -42,6 +42,7 @@ Chi2Result chi2_test(const std::function<std::optional<DirectionSample>(Pcg32&)>
                      const std::function<float(Vec3)>& pdf, const Chi2Options& options = {});
 
 // Integral of f over the sphere by stratified quadrature on the (cos theta, phi) grid.
-double integrate_sphere(const std::function<double(Vec3)>& f, int theta_res = 256, int phi_res = 512);
+double integrate_sphere(const std::function<double(Vec3)>& f, int theta_res = 256,
+                        int phi_res = 512);
 
 }  // namespace caustica::test

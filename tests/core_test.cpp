@@ -9,7 +9,8 @@
 using namespace caustica;
 
 TEST(Pcg32, SameKeyGivesSameStreamDifferentKeysDiffer) {
-  Pcg32 a = Pcg32::for_sample(5, 3, 1), b = Pcg32::for_sample(5, 3, 1), c = Pcg32::for_sample(6, 3, 1);
+  Pcg32 a = Pcg32::for_sample(5, 3, 1), b = Pcg32::for_sample(5, 3, 1),
+        c = Pcg32::for_sample(6, 3, 1);
   int same_as_c = 0;
   for (int i = 0; i < 100; ++i) {
     const uint32_t va = a.next_u32();
@@ -48,7 +49,8 @@ TEST(Frame, IsOrthonormalAndRoundTrips) {
 }
 
 TEST(Transform, InverseUndoesAndComposesLikeMatrices) {
-  const Transform t = Transform::translate({1, 2, 3}) * Transform::rotate(30, {1, 1, 0}) * Transform::scale({2, 3, 4});
+  const Transform t = Transform::translate({1, 2, 3}) * Transform::rotate(30, {1, 1, 0}) *
+                      Transform::scale({2, 3, 4});
   const Vec3 p(0.3f, -0.7f, 2.f);
   const Vec3 q = t.inverse().point(t.point(p));
   EXPECT_NEAR(distance(p, q), 0, 1e-5);

@@ -28,8 +28,7 @@ void parse_like_the_fuzzer(const std::string& bytes, SceneBuilder& builder) {
 }
 
 TEST(GltfCrashers, EveryFuzzerFindingFailsCleanly) {
-  const std::filesystem::path dir =
-      std::filesystem::path(CAUSTICA_TEST_DATA) / "gltf_crashers";
+  const std::filesystem::path dir = std::filesystem::path(CAUSTICA_TEST_DATA) / "gltf_crashers";
   int count = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().filename() == "README.md") continue;

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "geometry/interaction.h"
 #include "lights/light.h"
 #include "pbrt_test_util.h"
-#include "geometry/interaction.h"
 
 namespace caustica {
 namespace {

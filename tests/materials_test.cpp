@@ -15,9 +15,9 @@
 #include "chi2.h"
 #include "core/arena.h"
 #include "core/warp.h"
+#include "geometry/interaction.h"
 #include "materials/fresnel.h"
 #include "materials/microfacet.h"
-#include "geometry/interaction.h"
 
 namespace caustica {
 namespace {

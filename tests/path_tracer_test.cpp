@@ -60,7 +60,8 @@ TEST(PathTracer, BitIdenticalForOneAndTwoThreads) {
   const auto a = render_with(*scene, "pt", 4, {}, 1);
   const auto b = render_with(*scene, "pt", 4, {}, 2);
   ASSERT_EQ(a.image.pixel_count(), b.image.pixel_count());
-  for (size_t i = 0; i < a.image.pixel_count(); ++i) ASSERT_EQ(a.image[i], b.image[i]) << "pixel " << i;
+  for (size_t i = 0; i < a.image.pixel_count(); ++i)
+    ASSERT_EQ(a.image[i], b.image[i]) << "pixel " << i;
 }
 
 TEST(PathTracer, DifferentSeedsGiveDifferentNoise) {

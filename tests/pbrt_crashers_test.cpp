@@ -16,8 +16,7 @@ namespace {
 void ignore_warning(const std::string&) {}
 
 TEST(PbrtCrashers, EveryFuzzerFindingFailsCleanly) {
-  const std::filesystem::path dir =
-      std::filesystem::path(CAUSTICA_TEST_DATA) / "pbrt_crashers";
+  const std::filesystem::path dir = std::filesystem::path(CAUSTICA_TEST_DATA) / "pbrt_crashers";
   int count = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().filename() == "README.md") continue;

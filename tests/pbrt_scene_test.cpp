@@ -7,10 +7,10 @@
 #include <cmath>
 #include <filesystem>
 
+#include "geometry/interaction.h"
 #include "io/pbrt/color.h"
 #include "lights/light.h"
 #include "pbrt_test_util.h"
-#include "geometry/interaction.h"
 #include "test_scenes.h"
 
 namespace caustica {
@@ -253,9 +253,7 @@ TEST(PbrtInstancing, ObjectInstancesAreFlattenedCopies) {
 
 // --- The shared scenes ---------------------------------------------------------------
 
-std::string shared(const std::string& rel) {
-  return std::string(CAUSTICA_SCENES) + "/" + rel;
-}
+std::string shared(const std::string& rel) { return std::string(CAUSTICA_SCENES) + "/" + rel; }
 
 TEST(PbrtSharedScenes, CornellCausticsLoadsAndProjectsLikePbrtV4) {
   test::captured_warnings().clear();

@@ -26,7 +26,8 @@ std::string read_file(const fs::path& p) {
 
 std::string chromium_command(const fs::path& profile) {
   return "chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
-         "--disable-background-networking --disable-component-update --disable-sync --user-data-dir=" +
+         "--disable-background-networking --disable-component-update --disable-sync "
+         "--user-data-dir=" +
          profile.string();
 }
 
@@ -46,21 +47,23 @@ TEST(ReportBrowser, ViewerPlotAndTableWorkInHeadlessChromium) {
   std::string integrators = "pt";
   for (const auto& n : caustica::integrator_names())
     if (n == "bpt" || (n == "lt" && integrators == "pt")) integrators = "pt," + n;
-  const std::string compare = std::string(CAUSTICA_BINARY) + " compare cornell --integrators " + integrators +
-                              " --time 1 --reference-time 1 --resolution 48x48 --reference-integrator pt --out " +
-                              (dir / "report").string() + " > " + (dir / "compare.log").string() + " 2>&1";
+  const std::string compare =
+      std::string(CAUSTICA_BINARY) + " compare cornell --integrators " + integrators +
+      " --time 1 --reference-time 1 --resolution 48x48 --reference-integrator pt --out " +
+      (dir / "report").string() + " > " + (dir / "compare.log").string() + " 2>&1";
   ASSERT_EQ(std::system(compare.c_str()), 0) << read_file(dir / "compare.log");
-  for (const char* f : {"index.html", "results.json", "results.csv", "convergence.svg", "reference.png", "pt.png",
-                        "pt.exr", "pt_error.png"})
+  for (const char* f : {"index.html", "results.json", "results.csv", "convergence.svg",
+                        "reference.png", "pt.png", "pt.exr", "pt_error.png"})
     EXPECT_TRUE(fs::exists(dir / "report" / f)) << f;
   const std::string html = read_file(dir / "report" / "index.html");
   EXPECT_EQ(html.find("http://"), html.find("http://www.w3.org/2000/svg"));  // no network resources
   EXPECT_EQ(html.find("https://"), std::string::npos);
 
   const std::string url = "file://" + (dir / "report" / "index.html").string();
-  const std::string dump = chromium_command(dir / "profile") +
-                           " --enable-logging=stderr --v=0 --virtual-time-budget=10000 --dump-dom '" + url +
-                           "#selftest' > " + (dir / "dom.html").string() + " 2> " + (dir / "chromium.log").string();
+  const std::string dump =
+      chromium_command(dir / "profile") +
+      " --enable-logging=stderr --v=0 --virtual-time-budget=10000 --dump-dom '" + url +
+      "#selftest' > " + (dir / "dom.html").string() + " 2> " + (dir / "chromium.log").string();
   ASSERT_EQ(std::system(dump.c_str()), 0) << read_file(dir / "chromium.log");
   const std::string dom = read_file(dir / "dom.html");
   EXPECT_NE(dom.find("<title>selftest:pass</title>"), std::string::npos)
@@ -70,8 +73,9 @@ TEST(ReportBrowser, ViewerPlotAndTableWorkInHeadlessChromium) {
   EXPECT_EQ(log.find("CONSOLE"), std::string::npos) << log;
 
   const fs::path shot = dir / "shot.png";
-  const std::string screenshot = chromium_command(dir / "profile") + " --window-size=1000,900 --screenshot=" +
-                                 shot.string() + " '" + url + "' > /dev/null 2>&1";
+  const std::string screenshot = chromium_command(dir / "profile") +
+                                 " --window-size=1000,900 --screenshot=" + shot.string() + " '" +
+                                 url + "' > /dev/null 2>&1";
   ASSERT_EQ(std::system(screenshot.c_str()), 0);
   const caustica::Image img = caustica::read_image(shot.string(), false);
   ASSERT_GT(img.pixel_count(), 0u);

@@ -1,3 +1,5 @@
+#include "scene/scene.h"
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 #include <tbb/info.h>
@@ -7,7 +9,6 @@
 #include "io/builtin_scenes.h"
 #include "io/scene_builder.h"
 #include "materials/materials.h"
-#include "scene/scene.h"
 
 using namespace caustica;
 

@@ -16,7 +16,9 @@ namespace caustica::test {
 inline RenderResult render_with(const Scene& scene, const std::string& integrator, int spp,
                                 IntegratorSettings settings = {}, int threads = 0) {
   std::unique_ptr<tbb::global_control> limit;
-  if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+  if (threads > 0)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                  threads);
   auto in = make_integrator(integrator, settings);
   if (!in) throw std::runtime_error("unknown integrator " + integrator);
   RenderBudget budget;

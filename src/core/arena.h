@@ -15,7 +15,9 @@ namespace caustica {
 
 class ScratchArena {
  public:
-  explicit ScratchArena(size_t block_bytes = 16 * 1024) : block_bytes_(block_bytes) { grow(block_bytes); }
+  explicit ScratchArena(size_t block_bytes = 16 * 1024) : block_bytes_(block_bytes) {
+    grow(block_bytes);
+  }
   ScratchArena(const ScratchArena&) = delete;
   ScratchArena& operator=(const ScratchArena&) = delete;
 
@@ -37,7 +39,10 @@ class ScratchArena {
   }
 
   // Forget every allocation; memory is kept for reuse.
-  void reset() { current_ = 0; used_ = 0; }
+  void reset() {
+    current_ = 0;
+    used_ = 0;
+  }
 
  private:
   static constexpr std::align_val_t kAlignment{64};

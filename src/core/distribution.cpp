@@ -77,7 +77,8 @@ Distribution2D::Distribution2D(const std::vector<float>& values, int width, int 
   std::vector<float> marginal(height);
   conditional_.reserve(height);
   for (int v = 0; v < height; ++v) {
-    std::vector<float> row(values.begin() + size_t(v) * width, values.begin() + size_t(v + 1) * width);
+    std::vector<float> row(values.begin() + size_t(v) * width,
+                           values.begin() + size_t(v + 1) * width);
     double sum = 0;
     for (float f : row) sum += (f > 0 && std::isfinite(f)) ? f : 0.f;
     marginal[v] = float(sum / width);

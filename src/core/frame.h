@@ -17,7 +17,8 @@ struct Frame {
     const float sign = std::copysign(1.f, n.z);
     const float a = -1.f / (sign + n.z);
     const float b = n.x * n.y * a;
-    return Frame(Vec3(1.f + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3(b, sign + n.y * n.y * a, -n.y), n);
+    return Frame(Vec3(1.f + sign * n.x * n.x * a, sign * b, -sign * n.x),
+                 Vec3(b, sign + n.y * n.y * a, -n.y), n);
   }
   // Frame with normal n whose s axis follows the projection of dpdu onto the tangent plane.
   static Frame from_normal_tangent(Vec3 n, Vec3 dpdu) {

@@ -17,10 +17,14 @@ inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
 inline constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
 
 template <typename T>
-constexpr T sqr(T v) { return v * v; }
+constexpr T sqr(T v) {
+  return v * v;
+}
 
 template <typename T>
-constexpr T clamp(T v, T lo, T hi) { return std::min(std::max(v, lo), hi); }
+constexpr T clamp(T v, T lo, T hi) {
+  return std::min(std::max(v, lo), hi);
+}
 
 inline float lerp(float t, float a, float b) { return (1 - t) * a + t * b; }
 inline float safe_sqrt(float v) { return std::sqrt(std::max(v, 0.f)); }

@@ -14,9 +14,24 @@ struct Rgb {
   constexpr Rgb(float r_, float g_, float b_) : r(r_), g(g_), b(b_) {}
   constexpr float operator[](int i) const { return i == 0 ? r : (i == 1 ? g : b); }
   constexpr float& operator[](int i) { return i == 0 ? r : (i == 1 ? g : b); }
-  constexpr Rgb& operator+=(Rgb o) { r += o.r; g += o.g; b += o.b; return *this; }
-  constexpr Rgb& operator*=(Rgb o) { r *= o.r; g *= o.g; b *= o.b; return *this; }
-  constexpr Rgb& operator*=(float s) { r *= s; g *= s; b *= s; return *this; }
+  constexpr Rgb& operator+=(Rgb o) {
+    r += o.r;
+    g += o.g;
+    b += o.b;
+    return *this;
+  }
+  constexpr Rgb& operator*=(Rgb o) {
+    r *= o.r;
+    g *= o.g;
+    b *= o.b;
+    return *this;
+  }
+  constexpr Rgb& operator*=(float s) {
+    r *= s;
+    g *= s;
+    b *= s;
+    return *this;
+  }
   constexpr bool is_black() const { return r == 0 && g == 0 && b == 0; }
   bool is_finite() const { return std::isfinite(r) && std::isfinite(g) && std::isfinite(b); }
   constexpr float max_component() const { return std::max(r, std::max(g, b)); }

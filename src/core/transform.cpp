@@ -79,7 +79,7 @@ Transform Transform::translate(Vec3 d) {
   return {Mat4::from_rows(f), Mat4::from_rows(g)};
 }
 
-Transform Transform::scale(Vec3 s) { 
+Transform Transform::scale(Vec3 s) {
   const float f[16] = {s.x, 0, 0, 0, 0, s.y, 0, 0, 0, 0, s.z, 0, 0, 0, 0, 1};
   return Transform(Mat4::from_rows(f));
 }
@@ -104,7 +104,8 @@ Transform Transform::look_at(Vec3 pos, Vec3 look, Vec3 up) {
   Mat4 cam_to_world = Mat4::identity();
   const Vec3 dir = normalize(look - pos);
   Vec3 right = cross(normalize(up), dir);
-  if (length(right) == 0) throw std::invalid_argument("LookAt: 'up' is parallel to the view direction");
+  if (length(right) == 0)
+    throw std::invalid_argument("LookAt: 'up' is parallel to the view direction");
   right = normalize(right);
   const Vec3 new_up = cross(dir, right);
   for (int i = 0; i < 3; ++i) {
@@ -145,20 +146,23 @@ Vec3 Transform::point(Vec3 p) const {
 
 Vec3 Transform::vector(Vec3 v) const {
   const auto& a = m_.m;
-  return {a[0][0] * v.x + a[0][1] * v.y + a[0][2] * v.z, a[1][0] * v.x + a[1][1] * v.y + a[1][2] * v.z,
+  return {a[0][0] * v.x + a[0][1] * v.y + a[0][2] * v.z,
+          a[1][0] * v.x + a[1][1] * v.y + a[1][2] * v.z,
           a[2][0] * v.x + a[2][1] * v.y + a[2][2] * v.z};
 }
 
 Vec3 Transform::normal(Vec3 n) const {
   const auto& a = inv_.m;
-  return {a[0][0] * n.x + a[1][0] * n.y + a[2][0] * n.z, a[0][1] * n.x + a[1][1] * n.y + a[2][1] * n.z,
+  return {a[0][0] * n.x + a[1][0] * n.y + a[2][0] * n.z,
+          a[0][1] * n.x + a[1][1] * n.y + a[2][1] * n.z,
           a[0][2] * n.x + a[1][2] * n.y + a[2][2] * n.z};
 }
 
 Bounds3 Transform::bounds(const Bounds3& b) const {
   Bounds3 r;
   for (int i = 0; i < 8; ++i)
-    r.extend(point({(i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z}));
+    r.extend(
+        point({(i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z}));
   return r;
 }
 

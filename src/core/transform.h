@@ -45,9 +45,9 @@ class Transform {
   // True when the transform flips handedness (negative determinant of the 3x3 part).
   bool swaps_handedness() const;
 
-  Vec3 point(Vec3 p) const;      // homogeneous divide applied
+  Vec3 point(Vec3 p) const;  // homogeneous divide applied
   Vec3 vector(Vec3 v) const;
-  Vec3 normal(Vec3 n) const;     // inverse transpose, not normalised
+  Vec3 normal(Vec3 n) const;  // inverse transpose, not normalised
   Ray ray(const Ray& r) const { return {point(r.o), vector(r.d), r.tmax}; }
   Bounds3 bounds(const Bounds3& b) const;
 

@@ -27,9 +27,24 @@ struct Vec3 {
   constexpr float operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
   constexpr float& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
   constexpr Vec3 operator-() const { return {-x, -y, -z}; }
-  constexpr Vec3& operator+=(Vec3 o) { x += o.x; y += o.y; z += o.z; return *this; }
-  constexpr Vec3& operator-=(Vec3 o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
-  constexpr Vec3& operator*=(float s) { x *= s; y *= s; z *= s; return *this; }
+  constexpr Vec3& operator+=(Vec3 o) {
+    x += o.x;
+    y += o.y;
+    z += o.z;
+    return *this;
+  }
+  constexpr Vec3& operator-=(Vec3 o) {
+    x -= o.x;
+    y -= o.y;
+    z -= o.z;
+    return *this;
+  }
+  constexpr Vec3& operator*=(float s) {
+    x *= s;
+    y *= s;
+    z *= s;
+    return *this;
+  }
 };
 constexpr Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 constexpr Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
@@ -49,8 +64,12 @@ inline float length(Vec3 v) { return std::sqrt(dot(v, v)); }
 inline Vec3 normalize(Vec3 v) { return v / length(v); }
 inline float distance(Vec3 a, Vec3 b) { return length(a - b); }
 inline float distance_squared(Vec3 a, Vec3 b) { return length_squared(a - b); }
-inline Vec3 min(Vec3 a, Vec3 b) { return {std::fmin(a.x, b.x), std::fmin(a.y, b.y), std::fmin(a.z, b.z)}; }
-inline Vec3 max(Vec3 a, Vec3 b) { return {std::fmax(a.x, b.x), std::fmax(a.y, b.y), std::fmax(a.z, b.z)}; }
+inline Vec3 min(Vec3 a, Vec3 b) {
+  return {std::fmin(a.x, b.x), std::fmin(a.y, b.y), std::fmin(a.z, b.z)};
+}
+inline Vec3 max(Vec3 a, Vec3 b) {
+  return {std::fmax(a.x, b.x), std::fmax(a.y, b.y), std::fmax(a.z, b.z)};
+}
 inline Vec3 abs(Vec3 v) { return {std::abs(v.x), std::abs(v.y), std::abs(v.z)}; }
 inline float max_component(Vec3 v) { return std::fmax(v.x, std::fmax(v.y, v.z)); }
 // Flip n to the hemisphere of v.
@@ -72,8 +91,14 @@ struct Ray {
 struct Bounds3 {
   Vec3 lo{kInfinity, kInfinity, kInfinity};
   Vec3 hi{-kInfinity, -kInfinity, -kInfinity};
-  void extend(Vec3 p) { lo = min(lo, p); hi = max(hi, p); }
-  void extend(const Bounds3& b) { lo = min(lo, b.lo); hi = max(hi, b.hi); }
+  void extend(Vec3 p) {
+    lo = min(lo, p);
+    hi = max(hi, p);
+  }
+  void extend(const Bounds3& b) {
+    lo = min(lo, b.lo);
+    hi = max(hi, b.hi);
+  }
   bool empty() const { return lo.x > hi.x; }
   Vec3 center() const { return (lo + hi) * 0.5f; }
   Vec3 diagonal() const { return hi - lo; }

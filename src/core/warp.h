@@ -11,7 +11,9 @@ Vec2 sample_uniform_disk_concentric(Vec2 u);
 
 // Cosine-weighted hemisphere around +z; pdf = cos(theta)/pi.
 Vec3 sample_cosine_hemisphere(Vec2 u);
-inline float cosine_hemisphere_pdf(float cos_theta) { return cos_theta > 0 ? cos_theta * kInvPi : 0.f; }
+inline float cosine_hemisphere_pdf(float cos_theta) {
+  return cos_theta > 0 ? cos_theta * kInvPi : 0.f;
+}
 
 Vec3 sample_uniform_hemisphere(Vec2 u);
 inline float uniform_hemisphere_pdf() { return kInv2Pi; }

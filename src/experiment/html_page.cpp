@@ -11,11 +11,20 @@ std::string escape(const std::string& s) {
   std::string o;
   for (char c : s) {
     switch (c) {
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '&': o += "&amp;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += c;
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '&':
+        o += "&amp;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      default:
+        o += c;
     }
   }
   return o;
@@ -129,44 +138,56 @@ constexpr const char* kScript = R"JS(
 
 }  // namespace
 
-std::string comparison_html(const ComparisonResult& result, const nlohmann::json& summary, const std::string& svg) {
+std::string comparison_html(const ComparisonResult& result, const nlohmann::json& summary,
+                            const std::string& svg) {
   nlohmann::json views = nlohmann::json::array();
-  views.push_back({{"name", "reference"}, {"image", "reference.png"}, {"caption", result.reference_description}});
+  views.push_back({{"name", "reference"},
+                   {"image", "reference.png"},
+                   {"caption", result.reference_description}});
   for (const auto& r : result.runs) {
     const auto& e = r.snapshots.back().errors;
     views.push_back({{"name", r.integrator},
                      {"image", r.integrator + ".png"},
                      {"error", r.integrator + "_error.png"},
-                     {"caption", std::to_string(r.iterations) + " iterations in " + fmt_g(r.seconds, "%.1f") +
-                                     " s, relMSE " + fmt_g(e.rel_mse)}});
+                     {"caption", std::to_string(r.iterations) + " iterations in " +
+                                     fmt_g(r.seconds, "%.1f") + " s, relMSE " + fmt_g(e.rel_mse)}});
   }
   std::ostringstream o;
-  o << "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>caustica: " << escape(result.scene)
-    << "</title>\n<style>" << kStyle << "</style></head>\n<body>\n<h1>" << escape(result.scene) << ": "
-    << fmt_g(result.config.seconds, "%g") << " s per integrator</h1>\n"
-    << "<p class=\"hint\">Keys: 0 reference, 1-9 integrators, arrows cycle, e error view, f fit. Wheel zooms, drag "
+  o << "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>caustica: "
+    << escape(result.scene) << "</title>\n<style>" << kStyle << "</style></head>\n<body>\n<h1>"
+    << escape(result.scene) << ": " << fmt_g(result.config.seconds, "%g")
+    << " s per integrator</h1>\n"
+    << "<p class=\"hint\">Keys: 0 reference, 1-9 integrators, arrows cycle, e error view, f fit. "
+       "Wheel zooms, drag "
        "pans; the view stays put when switching.</p>\n"
-    << "<div id=\"buttons\"></div><label><input type=\"checkbox\" id=\"errtoggle\"> error view (e)</label>\n"
+    << "<div id=\"buttons\"></div><label><input type=\"checkbox\" id=\"errtoggle\"> error view "
+       "(e)</label>\n"
     << "<div id=\"stage\"><img id=\"shown\" alt=\"render\"></div><div id=\"caption\"></div>\n"
-    << "<h2>Convergence</h2>\n" << svg
-    << "<h2>Summary</h2>\n<table id=\"summary\"><thead><tr><th>integrator</th><th>iterations</th><th>Mrays/s</th>"
-       "<th>RMSE</th><th>relMSE</th><th>relMSE (trimmed 0.1%)</th><th>SSIM</th><th>speed-up vs pt</th></tr></thead><tbody>\n";
+    << "<h2>Convergence</h2>\n"
+    << svg
+    << "<h2>Summary</h2>\n<table "
+       "id=\"summary\"><thead><tr><th>integrator</th><th>iterations</th><th>Mrays/s</th>"
+       "<th>RMSE</th><th>relMSE</th><th>relMSE (trimmed 0.1%)</th><th>SSIM</th><th>speed-up vs "
+       "pt</th></tr></thead><tbody>\n";
   for (const auto& row : summary) {
     const auto& e = row["errors"];
-    o << "<tr><td>" << escape(row["integrator"].get<std::string>()) << "</td><td>" << row["iterations"].get<uint32_t>()
-      << "</td><td>" << fmt_g(row["rays_per_second"].get<double>() * 1e-6, "%.2f") << "</td><td>"
-      << fmt_g(e["rmse"].get<double>()) << "</td><td>" << fmt_g(e["relmse"].get<double>()) << "</td><td>"
-      << fmt_g(e["relmse_trimmed"].get<double>()) << "</td><td>" << fmt_g(e["ssim"].get<double>(), "%.4f") << "</td><td>"
+    o << "<tr><td>" << escape(row["integrator"].get<std::string>()) << "</td><td>"
+      << row["iterations"].get<uint32_t>() << "</td><td>"
+      << fmt_g(row["rays_per_second"].get<double>() * 1e-6, "%.2f") << "</td><td>"
+      << fmt_g(e["rmse"].get<double>()) << "</td><td>" << fmt_g(e["relmse"].get<double>())
+      << "</td><td>" << fmt_g(e["relmse_trimmed"].get<double>()) << "</td><td>"
+      << fmt_g(e["ssim"].get<double>(), "%.4f") << "</td><td>"
       << (row.contains("speedup_vs_pt") && row["speedup_vs_pt"].is_number()
               ? fmt_g(row["speedup_vs_pt"].get<double>(), "%.2fx")
               : std::string("-"))
       << "</td></tr>\n";
   }
-  o << "</tbody></table>\n<p class=\"hint\">Speed-up: the time pt needs to reach this integrator's final relMSE "
+  o << "</tbody></table>\n<p class=\"hint\">Speed-up: the time pt needs to reach this integrator's "
+       "final relMSE "
        "(read off pt's curve; beyond it relMSE ~ 1/t), divided by this integrator's time.</p>\n"
     << "<p class=\"hint\">Reference: " << escape(result.reference_description) << "</p>\n"
-    << "<pre id=\"selftest\"></pre>\n<script type=\"application/json\" id=\"views\">" << views.dump()
-    << "</script>\n<script>" << kScript << "</script>\n</body></html>\n";
+    << "<pre id=\"selftest\"></pre>\n<script type=\"application/json\" id=\"views\">"
+    << views.dump() << "</script>\n<script>" << kScript << "</script>\n</body></html>\n";
   return o.str();
 }
 

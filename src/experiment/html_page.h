@@ -6,14 +6,14 @@
 // page title ("selftest:pass" or "selftest:fail: reason") for the headless browser test.
 #pragma once
 
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "experiment/comparison.h"
 
 namespace caustica {
 
-std::string comparison_html(const ComparisonResult& result, const nlohmann::json& summary, const std::string& svg);
+std::string comparison_html(const ComparisonResult& result, const nlohmann::json& summary,
+                            const std::string& svg);
 
 }  // namespace caustica

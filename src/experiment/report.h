@@ -13,8 +13,8 @@ struct ReportOptions {
   float exposure = 0;  // PNG exposure in stops
 };
 
-void write_comparison_report(const ComparisonResult& result, const Image& reference, const std::string& dir,
-                             const ReportOptions& options = {});
+void write_comparison_report(const ComparisonResult& result, const Image& reference,
+                             const std::string& dir, const ReportOptions& options = {});
 
 // The convergence plot (relMSE against time, log-log, one line per integrator) as SVG.
 std::string convergence_svg(const ComparisonResult& result, int width = 720, int height = 440);

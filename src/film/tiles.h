@@ -20,7 +20,8 @@ void parallel_for_tiles(int width, int height, Fn&& fn) {
   tbb::parallel_for(0, tiles_x * tiles_y, [&](int t) {
     thread_local ScratchArena arena;
     const int tx = t % tiles_x, ty = t / tiles_x;
-    const Tile tile{tx * kTile, ty * kTile, std::min(width, (tx + 1) * kTile), std::min(height, (ty + 1) * kTile)};
+    const Tile tile{tx * kTile, ty * kTile, std::min(width, (tx + 1) * kTile),
+                    std::min(height, (ty + 1) * kTile)};
     arena.reset();
     fn(tile, arena);
   });

@@ -12,18 +12,18 @@ class Material;
 class Light;
 
 struct SurfaceInteraction {
-  Vec3 p;              // hit position (recomputed from the primitive, not o + t d)
-  Vec3 p_error;        // conservative absolute error bound on p, per axis
-  Vec3 ng;             // unit geometric normal: winding normal cross(p1-p0, p2-p0) for triangles
-                       // (flipped by ReverseOrientation / handedness; faced toward the shading
-                       // normal when the mesh has normals), outward for spheres
-  Frame shading;       // shading frame; shading.n is the interpolated normal (ng if none)
-  Vec2 uv;             // surface parameterisation (mesh uv, or sphere phi/theta)
-  Vec3 wo;             // unit direction back toward the ray origin
-  float t = 0;         // ray parameter of the hit
-  uint32_t geom_id = 0, prim_id = 0;  // Embree ids, for debugging and stored light vertices
-  const Material* material = nullptr; // may be null: an interface only (no scattering)
-  const Light* area_light = nullptr;  // the emitter of this primitive, if any
+  Vec3 p;         // hit position (recomputed from the primitive, not o + t d)
+  Vec3 p_error;   // conservative absolute error bound on p, per axis
+  Vec3 ng;        // unit geometric normal: winding normal cross(p1-p0, p2-p0) for triangles
+                  // (flipped by ReverseOrientation / handedness; faced toward the shading
+                  // normal when the mesh has normals), outward for spheres
+  Frame shading;  // shading frame; shading.n is the interpolated normal (ng if none)
+  Vec2 uv;        // surface parameterisation (mesh uv, or sphere phi/theta)
+  Vec3 wo;        // unit direction back toward the ray origin
+  float t = 0;    // ray parameter of the hit
+  uint32_t geom_id = 0, prim_id = 0;   // Embree ids, for debugging and stored light vertices
+  const Material* material = nullptr;  // may be null: an interface only (no scattering)
+  const Light* area_light = nullptr;   // the emitter of this primitive, if any
 
   // Ray origin nudged off the surface along ng, to the side of w (pbrt-v4's OffsetRayOrigin).
   Vec3 offset_origin(Vec3 w) const {
@@ -36,8 +36,10 @@ struct SurfaceInteraction {
     if (dot(w, ng) < 0) offset = -offset;
     Vec3 po = p + offset;
     for (int i = 0; i < 3; ++i) {  // round away from p so the offset is never lost
-      if (offset[i] > 0) po[i] = std::nextafter(po[i], kInfinity);
-      else if (offset[i] < 0) po[i] = std::nextafter(po[i], -kInfinity);
+      if (offset[i] > 0)
+        po[i] = std::nextafter(po[i], kInfinity);
+      else if (offset[i] < 0)
+        po[i] = std::nextafter(po[i], -kInfinity);
     }
     return po;
   }

@@ -26,7 +26,8 @@ Vec3 TriangleMesh::face_normal(size_t i) const {
   n = n / len;
   if (!normals.empty()) {
     // pbrt-v4: the shading normals are authoritative for the side of the surface.
-    const Vec3 ns = normals[indices[3 * i]] + normals[indices[3 * i + 1]] + normals[indices[3 * i + 2]];
+    const Vec3 ns =
+        normals[indices[3 * i]] + normals[indices[3 * i + 1]] + normals[indices[3 * i + 2]];
     return face_forward(n, ns);
   }
   return reverse_orientation ? -n : n;

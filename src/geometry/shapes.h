@@ -5,8 +5,8 @@
 #include <memory>
 #include <vector>
 
-#include "core/transform.h"
 #include "core/rgb.h"
+#include "core/transform.h"
 #include "core/vec.h"
 
 namespace caustica {
@@ -16,8 +16,8 @@ class Light;
 
 struct TriangleMesh {
   std::vector<Vec3> positions;
-  std::vector<Vec3> normals;  // optional: per-vertex shading normals (empty if none)
-  std::vector<Vec2> uvs;      // optional: per-vertex uv (empty: (0,0),(1,0),(1,1) per triangle)
+  std::vector<Vec3> normals;      // optional: per-vertex shading normals (empty if none)
+  std::vector<Vec2> uvs;          // optional: per-vertex uv (empty: (0,0),(1,0),(1,1) per triangle)
   std::vector<uint32_t> indices;  // 3 per triangle
   // Which side is "outside" when there are no shading normals: false = the winding normal
   // cross(p1 - p0, p2 - p0). Loaders call flip_orientation() for pbrt's ReverseOrientation;

@@ -52,7 +52,8 @@ struct UvMapping {
 class ImageTexture final : public Texture {
  public:
   // Throws std::invalid_argument if `image` is null or empty.
-  ImageTexture(std::shared_ptr<const Image> image, UvMapping mapping, Rgb scale = Rgb(1.f), bool invert = false);
+  ImageTexture(std::shared_ptr<const Image> image, UvMapping mapping, Rgb scale = Rgb(1.f),
+               bool invert = false);
   Rgb eval(const TextureContext& ctx) const override;
 
  private:

@@ -7,8 +7,9 @@ namespace caustica {
 
 Rgb inferno_ramp(float t) {
   // Piecewise-linear through samples of matplotlib's "inferno" (display sRGB).
-  static const Rgb stops[] = {{0.001f, 0.000f, 0.014f}, {0.258f, 0.039f, 0.406f}, {0.578f, 0.148f, 0.404f},
-                              {0.865f, 0.317f, 0.226f}, {0.988f, 0.645f, 0.040f}, {0.988f, 0.998f, 0.645f}};
+  static const Rgb stops[] = {{0.001f, 0.000f, 0.014f}, {0.258f, 0.039f, 0.406f},
+                              {0.578f, 0.148f, 0.404f}, {0.865f, 0.317f, 0.226f},
+                              {0.988f, 0.645f, 0.040f}, {0.988f, 0.998f, 0.645f}};
   constexpr int n = sizeof(stops) / sizeof(stops[0]);
   t = clamp(std::isfinite(t) ? t : 1.f, 0.f, 1.f) * (n - 1);
   const int i = std::min(int(t), n - 2);
@@ -16,7 +17,8 @@ Rgb inferno_ramp(float t) {
   return stops[i] * (1 - f) + stops[i + 1] * f;
 }
 
-Image false_color_rel_error(const Image& img, const Image& ref, float log_min, float log_max, float eps) {
+Image false_color_rel_error(const Image& img, const Image& ref, float log_min, float log_max,
+                            float eps) {
   if (img.width() != ref.width() || img.height() != ref.height())
     throw std::invalid_argument("false_color_rel_error: image sizes differ");
   Image out(img.width(), img.height());

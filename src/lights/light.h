@@ -26,36 +26,43 @@ enum class LightType : uint8_t {
 };
 
 struct LightLiSample {
-  Rgb radiance;          // radiance (intensity / dist^2 for point lights) arriving at ref
-  Vec3 wi;               // unit direction from ref toward the light
-  float distance = 0;    // from ref to p_light; kInfinity for distant and infinite lights
-  Vec3 p_light;          // the sampled point on the light (shadow ray target)
-  Vec3 n_light;          // the light's surface normal there (zero for point-like lights)
-  float pdf_w = 0;       // solid-angle density at ref of this sample (1 for delta lights)
+  Rgb radiance;            // radiance (intensity / dist^2 for point lights) arriving at ref
+  Vec3 wi;                 // unit direction from ref toward the light
+  float distance = 0;      // from ref to p_light; kInfinity for distant and infinite lights
+  Vec3 p_light;            // the sampled point on the light (shadow ray target)
+  Vec3 n_light;            // the light's surface normal there (zero for point-like lights)
+  float pdf_w = 0;         // solid-angle density at ref of this sample (1 for delta lights)
   float pdf_emit_pos = 0;  // what pdf_le would report for (p_light, -wi): area density
   float pdf_emit_dir = 0;  // ... and solid-angle density of direction -wi
   float cos_at_light = 1;  // |cos| between -wi and n_light (1 for point-like lights)
 };
 
 struct LightLeSample {
-  Rgb radiance;           // emitted radiance (intensity for point lights) along dir
-  Vec3 p;                 // emission point
-  Vec3 n;                 // surface normal at p (zero for point lights, = dir for distant/env)
-  Vec3 dir;               // unit propagation direction, leaving the light
-  float pdf_pos = 0;      // area density of p
-  float pdf_dir = 0;      // solid-angle density of dir
-  float cos_at_light = 1; // |cos(n, dir)| (1 for point lights, distant and env)
+  Rgb radiance;            // emitted radiance (intensity for point lights) along dir
+  Vec3 p;                  // emission point
+  Vec3 n;                  // surface normal at p (zero for point lights, = dir for distant/env)
+  Vec3 dir;                // unit propagation direction, leaving the light
+  float pdf_pos = 0;       // area density of p
+  float pdf_dir = 0;       // solid-angle density of dir
+  float cos_at_light = 1;  // |cos(n, dir)| (1 for point lights, distant and env)
 };
 
 class Light {
  public:
   virtual ~Light() = default;
   virtual LightType type() const = 0;
-  bool is_delta() const { return type() == LightType::DeltaPosition || type() == LightType::DeltaDirection; }
-  bool is_infinite() const { return type() == LightType::Infinite || type() == LightType::DeltaDirection; }
+  bool is_delta() const {
+    return type() == LightType::DeltaPosition || type() == LightType::DeltaDirection;
+  }
+  bool is_infinite() const {
+    return type() == LightType::Infinite || type() == LightType::DeltaDirection;
+  }
 
   // Called once with the scene bounds before rendering (infinite lights need the radius).
-  virtual void preprocess(Vec3 scene_center, float scene_radius) { (void)scene_center; (void)scene_radius; }
+  virtual void preprocess(Vec3 scene_center, float scene_radius) {
+    (void)scene_center;
+    (void)scene_radius;
+  }
   // Total emitted power (flux), for the power-based light distribution.
   virtual Rgb power() const = 0;
 
@@ -68,9 +75,18 @@ class Light {
   // --- Radiance seen by a ray that hits the light ----------------------------------------
   // Area lights: radiance leaving point p with normal n (the primitive's geometric normal)
   // and uv, toward w (unit, pointing away from the light).
-  virtual Rgb radiance(Vec3 p, Vec3 n, Vec2 uv, Vec3 w) const { (void)p; (void)n; (void)uv; (void)w; return {}; }
+  virtual Rgb radiance(Vec3 p, Vec3 n, Vec2 uv, Vec3 w) const {
+    (void)p;
+    (void)n;
+    (void)uv;
+    (void)w;
+    return {};
+  }
   // Infinite lights: radiance arriving along a ray that escaped in direction d (unit).
-  virtual Rgb radiance_escaped(Vec3 d) const { (void)d; return {}; }
+  virtual Rgb radiance_escaped(Vec3 d) const {
+    (void)d;
+    return {};
+  }
 
   // --- Emission of light subpaths ----------------------------------------------------------
   virtual std::optional<LightLeSample> sample_le(Vec2 u_pos, Vec2 u_dir) const = 0;

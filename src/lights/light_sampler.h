@@ -17,7 +17,9 @@ class LightSampler {
   bool empty() const { return lights_.empty(); }
   // Picks a light; *pmf is its selection probability. Returns nullptr if there are none.
   const Light* sample(float u, float* pmf) const;
-  float pmf(const Light* light) const { return lights_.empty() ? 0.f : distribution_.pmf(light->index); }
+  float pmf(const Light* light) const {
+    return lights_.empty() ? 0.f : distribution_.pmf(light->index);
+  }
 
  private:
   std::vector<const Light*> lights_;

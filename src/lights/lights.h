@@ -6,8 +6,8 @@
 #include <memory>
 
 #include "core/transform.h"
-#include "lights/light.h"
 #include "geometry/shapes.h"
+#include "lights/light.h"
 
 namespace caustica {
 
@@ -15,7 +15,8 @@ class Image;
 
 // Diffuse emitter on triangle `tri` of a world-space mesh: emits `radiance` on the side of
 // mesh.face_normal(tri), or both sides if two_sided.
-LightPtr make_triangle_area_light(const TriangleMesh& mesh, size_t tri, Rgb radiance, bool two_sided);
+LightPtr make_triangle_area_light(const TriangleMesh& mesh, size_t tri, Rgb radiance,
+                                  bool two_sided);
 // Diffuse emitter on a sphere: emits on the outside (inside if reverse_orientation).
 LightPtr make_sphere_area_light(const Sphere& sphere, Rgb radiance, bool two_sided);
 

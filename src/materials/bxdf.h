@@ -46,11 +46,11 @@ inline bool is_non_specular(uint32_t f) { return f & (kBxdfDiffuse | kBxdfGlossy
 inline bool is_transmissive(uint32_t f) { return f & kBxdfTransmission; }
 
 struct BsdfSample {
-  Rgb f;                 // BSDF value for wi (see delta convention above)
-  Vec3 wi;               // sampled direction (local frame in BxDF, world frame from Bsdf)
-  float pdf = 0;         // solid-angle density, or discrete probability for delta lobes
-  uint32_t flags = 0;    // the single lobe that was sampled (BxdfFlags)
-  float eta = 1;         // relative IOR crossed (eta_i/eta_t style as pbrt's etap), 1 if none
+  Rgb f;               // BSDF value for wi (see delta convention above)
+  Vec3 wi;             // sampled direction (local frame in BxDF, world frame from Bsdf)
+  float pdf = 0;       // solid-angle density, or discrete probability for delta lobes
+  uint32_t flags = 0;  // the single lobe that was sampled (BxdfFlags)
+  float eta = 1;       // relative IOR crossed (eta_i/eta_t style as pbrt's etap), 1 if none
   bool pdf_is_proportional = false;  // pdf is only an estimate (stochastic layered BSDFs)
 
   bool is_specular() const { return flags & kBxdfSpecular; }

@@ -6,8 +6,8 @@
 #include <memory>
 
 #include "core/arena.h"
-#include "materials/bsdf.h"
 #include "geometry/interaction.h"
+#include "materials/bsdf.h"
 
 namespace caustica {
 

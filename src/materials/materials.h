@@ -9,8 +9,8 @@
 #include <optional>
 #include <string_view>
 
-#include "materials/material.h"
 #include "geometry/texture.h"
+#include "materials/material.h"
 
 namespace caustica {
 
@@ -20,8 +20,8 @@ MaterialPtr make_diffuse(TexturePtr reflectance);
 struct ConductorParams {
   // Either complex IOR (eta, k) per RGB channel, or an artist `reflectance` (normal-incidence
   // colour, mapped to an equivalent eta/k as pbrt-v4 does: eta = 1, k = 2 sqrt(r) / sqrt(1 - r)).
-  TexturePtr eta, k;        // used when reflectance is null
-  TexturePtr reflectance;   // optional
+  TexturePtr eta, k;                    // used when reflectance is null
+  TexturePtr reflectance;               // optional
   TexturePtr u_roughness, v_roughness;  // null = smooth
   bool remap_roughness = true;
 };
@@ -30,7 +30,7 @@ MaterialPtr make_conductor(const ConductorParams& params);
 MaterialPtr make_mirror(Rgb reflectance = Rgb(1.f));
 
 struct DielectricParams {
-  float eta = 1.5f;         // interior IOR over exterior IOR
+  float eta = 1.5f;                     // interior IOR over exterior IOR
   TexturePtr u_roughness, v_roughness;  // null = smooth
   bool remap_roughness = true;
 };
@@ -39,19 +39,20 @@ MaterialPtr make_dielectric(const DielectricParams& params);
 MaterialPtr make_thin_dielectric(float eta);
 
 struct CoatedDiffuseParams {
-  TexturePtr reflectance;            // diffuse base albedo (default 0.5)
+  TexturePtr reflectance;               // diffuse base albedo (default 0.5)
   TexturePtr u_roughness, v_roughness;  // of the dielectric coat (default 0)
   bool remap_roughness = true;
-  float thickness = 0.01f;           // coat thickness (pbrt-v4 default)
-  float eta = 1.5f;                  // coat IOR
-  TexturePtr albedo;                 // medium albedo between the layers (default 0)
-  TexturePtr g;                      // HG asymmetry of that medium (default 0)
-  int max_depth = 10, n_samples = 1; // random-walk settings of the stochastic layered BSDF
+  float thickness = 0.01f;            // coat thickness (pbrt-v4 default)
+  float eta = 1.5f;                   // coat IOR
+  TexturePtr albedo;                  // medium albedo between the layers (default 0)
+  TexturePtr g;                       // HG asymmetry of that medium (default 0)
+  int max_depth = 10, n_samples = 1;  // random-walk settings of the stochastic layered BSDF
 };
 MaterialPtr make_coated_diffuse(const CoatedDiffuseParams& params);
 
 // pbrt-v4 "diffusetransmission": Lambertian reflection and transmission.
-MaterialPtr make_diffuse_transmission(TexturePtr reflectance, TexturePtr transmittance, float scale = 1.f);
+MaterialPtr make_diffuse_transmission(TexturePtr reflectance, TexturePtr transmittance,
+                                      float scale = 1.f);
 
 // pbrt-v4 "mix": picks a or b per surface point with probability `amount` of b (the choice
 // is a deterministic hash of the point, as pbrt-v4 does, so the result is a blend).

@@ -1,8 +1,8 @@
 // Roughness textures -> microfacet distribution, as pbrt-v4's materials do (private).
 #pragma once
 
-#include "materials/microfacet.h"
 #include "geometry/texture.h"
+#include "materials/microfacet.h"
 
 namespace caustica {
 

@@ -43,8 +43,9 @@ void ProgressBar::update(double fraction, double rate, const char* unit) {
     const int filled = int(fraction * kWidth);
     std::string bar(size_t(filled), '=');
     if (filled < kWidth) bar += '>' + std::string(size_t(kWidth - filled - 1), ' ');
-    std::fprintf(out_, "\r%s [%s] %3d%% %s ETA %s %.2f %s ", label_.c_str(), bar.c_str(), int(fraction * 100),
-                 format_duration(elapsed).c_str(), format_duration(eta).c_str(), rate, unit);
+    std::fprintf(out_, "\r%s [%s] %3d%% %s ETA %s %.2f %s ", label_.c_str(), bar.c_str(),
+                 int(fraction * 100), format_duration(elapsed).c_str(),
+                 format_duration(eta).c_str(), rate, unit);
     std::fflush(out_);
   } else {
     // Plain lines: every 10% or 5 s, whichever comes first.

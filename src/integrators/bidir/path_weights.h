@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "core/arena.h"
-#include "integrators/bidir/bidir_integrator.h"
 #include "geometry/interaction.h"
+#include "integrators/bidir/bidir_integrator.h"
 
 namespace caustica {
 class Scene;

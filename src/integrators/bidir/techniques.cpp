@@ -1,7 +1,7 @@
 #include "integrators/bidir/techniques.h"
 
-#include "lights/light.h"
 #include "geometry/camera.h"
+#include "lights/light.h"
 
 namespace caustica::bidir {
 

@@ -5,9 +5,9 @@
 #pragma once
 
 #include "core/vec.h"
+#include "geometry/interaction.h"
 #include "integrators/bidir/mis.h"
 #include "materials/bsdf.h"
-#include "geometry/interaction.h"
 
 namespace caustica {
 class Camera;

@@ -7,9 +7,9 @@
 #include <optional>
 #include <string>
 
+#include "geometry/shapes.h"
 #include "io/pbrt/context.h"
 #include "io/pbrt/parameters.h"
-#include "geometry/shapes.h"
 
 namespace caustica::pbrt {
 

@@ -8,6 +8,7 @@ packages=(
   libembree-dev libtbb-dev libopenexr-dev libimath-dev libstb-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libtinygltf-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  python3-dev pybind11-dev python3-numpy
 )
 # Extra packages for optional parts, e.g. `scripts/install-deps.sh chromium`.
 packages+=("$@")

@@ -13,8 +13,8 @@ struct ReportOptions {
   float exposure = 0;  // PNG exposure in stops
 };
 
-void write_comparison_report(const ComparisonResult& result, const Image& reference, const std::string& dir,
-                             const ReportOptions& options = {});
+void write_comparison_report(const ComparisonResult& result, const Image& reference,
+                             const std::string& dir, const ReportOptions& options = {});
 
 // The convergence plot (relMSE against time, log-log, one line per integrator) as SVG.
 std::string convergence_svg(const ComparisonResult& result, int width = 720, int height = 440);
@@ -22,5 +22,9 @@ std::string convergence_svg(const ComparisonResult& result, int width = 720, int
 // Summary rows: final errors and speed-up relative to `pt` in time-to-equal-relMSE
 // (speedup = time pt needs to reach this integrator's final relMSE / this run's time).
 nlohmann::json comparison_summary(const ComparisonResult& result);
+
+// What results.json holds: the scene, the settings, the summary rows and every run's snapshots.
+// The Python module returns it as a dict, so a script sees what the report's reader sees.
+nlohmann::json comparison_json(const ComparisonResult& result);
 
 }  // namespace caustica

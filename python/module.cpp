@@ -105,18 +105,18 @@ std::string lower_extension(const std::string& path) {
 }
 
 void write(const std::string& path, const py::handle& image, const py::handle& exposure) {
+  const std::string ext = lower_extension(path);
+  if (ext != ".exr" && ext != ".png" && ext != ".pfm")
+    throw py::value_error("cannot tell the format of '" + path + "': use .exr, .png or .pfm");
   const Image img = to_image(image, "image");
   const float stops = float(number_arg("exposure", exposure, -64, 64, false));
-  const std::string ext = lower_extension(path);
   py::gil_scoped_release release;
   if (ext == ".exr")
     write_exr(img, path);
   else if (ext == ".png")
     write_png_srgb(tonemap_srgb(img, stops), path);
-  else if (ext == ".pfm")
-    write_pfm(img, path);
   else
-    throw py::value_error("cannot tell the format of '" + path + "': use .exr, .png or .pfm");
+    write_pfm(img, path);
 }
 
 py::array_t<float> read(const std::string& path, bool srgb) {

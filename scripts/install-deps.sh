@@ -9,6 +9,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libfmt-dev libtinygltf-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin
+  python3-dev pybind11-dev python3-numpy
 )
 # Extra packages for optional parts, e.g. `scripts/install-deps.sh chromium`.
 packages+=("$@")

@@ -35,6 +35,27 @@ nlohmann::json comparison_summary(const ComparisonResult& result) {
   return rows;
 }
 
+nlohmann::json comparison_json(const ComparisonResult& result) {
+  nlohmann::json j;
+  j["scene"] = result.scene;
+  j["seconds_per_integrator"] = result.config.seconds;
+  j["threads"] = result.config.threads;
+  j["reference"] = result.reference_description;
+  j["interrupted"] = result.interrupted;
+  j["summary"] = comparison_summary(result);
+  j["runs"] = nlohmann::json::array();
+  for (const auto& r : result.runs) {
+    nlohmann::json run = {{"integrator", r.integrator}, {"seconds", r.seconds},
+                          {"iterations", r.iterations}, {"rays", r.rays},
+                          {"nonfinite", r.nonfinite},   {"stats", r.integrator_stats}};
+    for (const auto& s : r.snapshots)
+      run["snapshots"].push_back(
+          {{"seconds", s.seconds}, {"iterations", s.iterations}, {"errors", to_json(s.errors)}});
+    j["runs"].push_back(run);
+  }
+  return j;
+}
+
 std::string convergence_svg(const ComparisonResult& result, int W, int H) {
   static const char* colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e",
                                  "#9467bd", "#8c564b", "#e377c2", "#17becf"};
@@ -115,24 +136,7 @@ void write_comparison_report(const ComparisonResult& result, const Image& refere
     write_png_srgb(false_color_rel_error(r.image, reference),
                    (d / (r.integrator + "_error.png")).string());
   }
-  const nlohmann::json summary = comparison_summary(result);
-  nlohmann::json j;
-  j["scene"] = result.scene;
-  j["seconds_per_integrator"] = result.config.seconds;
-  j["threads"] = result.config.threads;
-  j["reference"] = result.reference_description;
-  j["interrupted"] = result.interrupted;
-  j["summary"] = summary;
-  j["runs"] = nlohmann::json::array();
-  for (const auto& r : result.runs) {
-    nlohmann::json run = {{"integrator", r.integrator}, {"seconds", r.seconds},
-                          {"iterations", r.iterations}, {"rays", r.rays},
-                          {"nonfinite", r.nonfinite},   {"stats", r.integrator_stats}};
-    for (const auto& s : r.snapshots)
-      run["snapshots"].push_back(
-          {{"seconds", s.seconds}, {"iterations", s.iterations}, {"errors", to_json(s.errors)}});
-    j["runs"].push_back(run);
-  }
+  const nlohmann::json j = comparison_json(result);
   write_file_atomic((d / "results.json").string(), j.dump(2) + "\n");
 
   std::ostringstream csv;
@@ -146,7 +150,7 @@ void write_comparison_report(const ComparisonResult& result, const Image& refere
 
   const std::string svg = convergence_svg(result);
   write_file_atomic((d / "convergence.svg").string(), svg);
-  write_file_atomic((d / "index.html").string(), comparison_html(result, summary, svg));
+  write_file_atomic((d / "index.html").string(), comparison_html(result, j["summary"], svg));
 }
 
 }  // namespace caustica

@@ -23,4 +23,8 @@ std::string convergence_svg(const ComparisonResult& result, int width = 720, int
 // (speedup = time pt needs to reach this integrator's final relMSE / this run's time).
 nlohmann::json comparison_summary(const ComparisonResult& result);
 
+// What results.json holds: the scene, the settings, the summary rows and every run's snapshots.
+// The Python module returns it as a dict, so a script sees what the report's reader sees.
+nlohmann::json comparison_json(const ComparisonResult& result);
+
 }  // namespace caustica

@@ -455,7 +455,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
     PixelAccumulator acc;
     acc.pixel = sample.pixel;
     acc.filter_weight = sample.filter_weight;
-    if (techniques_.enabled()) acc.techniques = const_cast<TechniqueImages*>(&techniques_);
+    if (techniques_.enabled()) acc.techniques = &techniques_;
     camera_path(scene, current_, sample, rng, acc, arena);
     *nonfinite += acc.nonfinite;
     return acc.sum;
@@ -661,7 +661,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
   std::vector<uint32_t> path_begin_;
   HashGrid grid_;
   Image splat_image_;
-  TechniqueImages techniques_;
+  // Written by the camera pass (estimate() is const): each pixel by the one task that owns it.
+  mutable TechniqueImages techniques_;
 
   // Statistics.
   uint32_t iterations_ = 0;

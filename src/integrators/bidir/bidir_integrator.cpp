@@ -19,6 +19,7 @@
 #include "integrators/bidir/hash_grid.h"
 #include "integrators/bidir/light_path_assignment.h"
 #include "integrators/bidir/light_vertex.h"
+#include "integrators/bidir/technique_images.h"
 #include "integrators/bidir/techniques.h"
 #include "integrators/camera_path.h"
 #include "integrators/path_vertex.h"
@@ -32,6 +33,7 @@ namespace caustica {
 namespace {
 
 using bidir::HashGrid;
+using bidir::TechniqueImages;
 using bidir::LightVertex;
 using bidir::LightVertexData;
 using bidir::MisRules;
@@ -93,63 +95,6 @@ const char* name_of(BidirAlgorithm a) {
   }
   return "?";
 }
-
-// One image per technique, allocated on first use. Key: (merge, s, t) with s light vertices
-// (the light point included) and t camera vertices (the lens included); a merge at a vertex
-// counts that vertex on both sides.
-class TechniqueImages {
- public:
-  static constexpr int kMaxVertices = 64;
-  static uint32_t key(bool merge, int s, int t) {
-    return (merge ? kMaxVertices * kMaxVertices : 0) +
-           uint32_t(std::min(s, kMaxVertices - 1)) * kMaxVertices +
-           uint32_t(std::min(t, kMaxVertices - 1));
-  }
-  void reset(int width, int height) {
-    width_ = width;
-    height_ = height;
-    for (auto& s : slots_) s.reset();
-    for (auto& p : pointers_) p.store(nullptr);
-  }
-  bool enabled() const { return width_ > 0; }
-  void add(uint32_t key, size_t pixel, Rgb value) {
-    Image* image = pointers_[key].load(std::memory_order_acquire);
-    if (!image) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (!slots_[key]) {
-        slots_[key] = std::make_unique<Image>(width_, height_);
-        pointers_[key].store(slots_[key].get(), std::memory_order_release);
-      }
-      image = slots_[key].get();
-    }
-    (*image)[pixel] += value;
-  }
-  // Writes each technique averaged over `iterations`; returns the files written.
-  std::vector<std::string> write(const std::string& dir, uint32_t iterations) const {
-    std::filesystem::create_directories(dir);
-    std::vector<std::string> files;
-    const float scale = iterations > 0 ? 1.f / float(iterations) : 0.f;
-    for (uint32_t k = 0; k < slots_.size(); ++k) {
-      if (!slots_[k]) continue;
-      Image out = *slots_[k];
-      for (Rgb& p : out.pixels()) p *= scale;
-      const bool merge = k >= uint32_t(kMaxVertices * kMaxVertices);
-      const uint32_t rest = k % (kMaxVertices * kMaxVertices);
-      const std::string name = std::string(merge ? "merge_" : "connect_") + "s" +
-                               std::to_string(rest / kMaxVertices) + "_t" +
-                               std::to_string(rest % kMaxVertices) + ".exr";
-      write_exr(out, (std::filesystem::path(dir) / name).string());
-      files.push_back(name);
-    }
-    return files;
-  }
-
- private:
-  int width_ = 0, height_ = 0;
-  std::mutex mutex_;
-  std::array<std::unique_ptr<Image>, 2 * kMaxVertices * kMaxVertices> slots_;
-  std::array<std::atomic<Image*>, 2 * kMaxVertices * kMaxVertices> pointers_{};
-};
 
 struct Splat {
   uint32_t pixel;

@@ -33,11 +33,11 @@ namespace caustica {
 namespace {
 
 using bidir::HashGrid;
-using bidir::TechniqueImages;
 using bidir::LightVertex;
 using bidir::LightVertexData;
 using bidir::MisRules;
 using bidir::MisSums;
+using bidir::TechniqueImages;
 
 // Light paths per chunk: at most 1024, fewer when that would leave fewer than 64 chunks (a small
 // image has few light paths; 4 chunks of 1024 kept 2 threads half idle at 64x64). It depends on

@@ -1,6 +1,7 @@
 #include "integrators/registry.h"
 
 #include "integrators/bidir/bidir_integrator.h"
+#include "integrators/guided_path_tracer.h"
 #include "integrators/path_tracer.h"
 
 namespace caustica {
@@ -27,6 +28,10 @@ std::vector<IntegratorInfo> make_registry() {
                true, true, MisHeuristic::Balance, bidir(BidirAlgorithm::Bpm)});
   r.push_back({"vcm", "vertex connection and merging: bpt and bpm under one MIS", false, true, true,
                MisHeuristic::Balance, bidir(BidirAlgorithm::Vcm)});
+  r.push_back({"guided-pt",
+               "path tracing guided by incident radiance learned while rendering (Mueller 2017)",
+               true, true, false, MisHeuristic::Power,
+               [](const IntegratorSettings& s) { return std::make_unique<GuidedPathTracer>(s); }});
   return r;
 }
 

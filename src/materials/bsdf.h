@@ -20,6 +20,7 @@ class Bsdf {
   bool valid() const { return bxdf_ != nullptr; }
   uint32_t flags() const { return bxdf_->flags(); }
   bool is_delta() const { return bxdf_->is_delta(); }
+  bool stochastic() const { return bxdf_->stochastic(); }
   const Frame& shading() const { return shading_; }
   Vec3 ng() const { return ng_; }
   const BxDF* bxdf() const { return bxdf_; }

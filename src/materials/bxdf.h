@@ -68,6 +68,10 @@ class BxDF {
   virtual float pdf(Vec3 wo, Vec3 wi, TransportMode mode) const = 0;
 
   bool is_delta() const { return !is_non_specular(flags()); }
+  // f() and pdf() are stochastic estimates, not values (the layered BSDF of coated_diffuse.cpp):
+  // only a sample's own weight f |cos| / pdf is exact, so a technique that divides f() by a
+  // density of its own (a guided direction, a mixture pdf) must not use this BxDF.
+  virtual bool stochastic() const { return false; }
 
  protected:
   ~BxDF() = default;

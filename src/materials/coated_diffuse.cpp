@@ -117,6 +117,7 @@ class LayeredBxDF : public BxDF {
         max_depth_(max_depth),
         n_samples_(std::max(n_samples, 1)) {}
 
+  bool stochastic() const override { return true; }
   uint32_t flags() const override {
     const uint32_t top = top_.flags(), bottom = bottom_.flags();
     uint32_t fl = kBxdfReflection;

@@ -1,0 +1,170 @@
+#include "guiding/directional_quadtree.h"
+
+#include <cmath>
+
+#include "core/math.h"
+
+namespace caustica {
+
+namespace {
+
+double sum(const std::array<double, 4>& e) { return (e[0] + e[1]) + (e[2] + e[3]); }
+
+}  // namespace
+
+Vec2 direction_to_square(Vec3 w) {
+  const float cos_theta = std::clamp(w.z, -1.f, 1.f);
+  float phi = std::atan2(w.y, w.x);
+  if (phi < 0) phi += 2 * kPi;
+  const float v = phi * (0.5f / kPi);
+  return {std::clamp((cos_theta + 1) * 0.5f, 0.f, kOneMinusEpsilon),
+          std::clamp(v, 0.f, kOneMinusEpsilon)};
+}
+
+Vec3 square_to_direction(Vec2 p) {
+  const float cos_theta = 2 * p.x - 1, sin_theta = safe_sqrt(1 - cos_theta * cos_theta);
+  const float phi = 2 * kPi * p.y;
+  return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta};
+}
+
+double DirectionalQuadtree::total() const { return sum(nodes_[0].energy); }
+
+void DirectionalQuadtree::record(Vec2 p, double value) {
+  double x = p.x, y = p.y;
+  uint32_t node = 0;
+  for (;;) {
+    const int ix = x >= 0.5, iy = y >= 0.5, q = ix + 2 * iy;
+    x = 2 * x - ix;
+    y = 2 * y - iy;
+    const uint32_t child = nodes_[node].child[q];
+    if (!child) {
+      nodes_[node].energy[q] += value;
+      return;
+    }
+    node = child;
+  }
+}
+
+void DirectionalQuadtree::propagate() {
+  for (size_t i = nodes_.size(); i-- > 0;)
+    for (int q = 0; q < 4; ++q)
+      if (const uint32_t c = nodes_[i].child[q]) nodes_[i].energy[q] = sum(nodes_[c].energy);
+}
+
+// Each level multiplies the density by 4 (a quadrant has a quarter of its parent's area) times
+// the quadrant's share of the parent's energy.
+float DirectionalQuadtree::pdf_square(Vec2 p) const {
+  double x = p.x, y = p.y, pdf = 1;
+  uint32_t node = 0;
+  for (;;) {
+    const std::array<double, 4>& e = nodes_[node].energy;
+    const double node_total = sum(e);
+    if (!(node_total > 0)) return 0;
+    const int ix = x >= 0.5, iy = y >= 0.5, q = ix + 2 * iy;
+    pdf *= 4 * e[q] / node_total;
+    x = 2 * x - ix;
+    y = 2 * y - iy;
+    const uint32_t child = nodes_[node].child[q];
+    if (!child) return float(pdf);
+    node = child;
+  }
+}
+
+float DirectionalQuadtree::pdf(Vec3 w) const {
+  return pdf_square(direction_to_square(w)) * kInv4Pi;
+}
+
+// Per level: the column (ix) with probability of its energy share, then the row (iy) within
+// the column; each rescales its coordinate of u to [0, 1), so the quadrant q is chosen with
+// probability e_q / total and u stays uniform for the next level.
+Vec2 DirectionalQuadtree::sample_square(Vec2 u) const {
+  double ux = u.x, uy = u.y;
+  double ox = 0, oy = 0, size = 1;
+  uint32_t node = 0;
+  for (;;) {
+    const std::array<double, 4>& e = nodes_[node].energy;
+    const double left = e[0] + e[2], node_total = left + (e[1] + e[3]);
+    const double p_left = left / node_total;
+    int ix;
+    if (ux < p_left) {
+      ix = 0;
+      ux /= p_left;
+    } else {
+      ix = 1;
+      ux = (ux - p_left) / (1 - p_left);
+    }
+    const double lower = e[ix], upper = e[ix + 2];
+    const double p_lower = lower / (lower + upper);
+    int iy;
+    if (uy < p_lower) {
+      iy = 0;
+      uy /= p_lower;
+    } else {
+      iy = 1;
+      uy = (uy - p_lower) / (1 - p_lower);
+    }
+    ux = std::min(ux, 1.0);
+    uy = std::min(uy, 1.0);
+    size *= 0.5;
+    ox += ix * size;
+    oy += iy * size;
+    const uint32_t child = nodes_[node].child[ix + 2 * iy];
+    if (!child) break;
+    node = child;
+  }
+  // The leaf's corners are dyadic (exact in float): keep the rounded point inside the leaf, so
+  // that pdf_square() finds the leaf it was sampled from.
+  auto inside = [size](double origin, double t) {
+    const float lo = float(origin), hi = float(origin + size);
+    return std::clamp(float(origin + size * t), lo, std::nextafter(hi, lo));
+  };
+  return {inside(ox, ux), inside(oy, uy)};
+}
+
+DirectionalQuadtree DirectionalQuadtree::refined(double rho, int max_depth,
+                                                 size_t* node_budget) const {
+  DirectionalQuadtree out;
+  const double whole = total();
+  if (!(whole > 0)) return out;
+  struct Pending {
+    uint32_t node;     // in `out`
+    int64_t old_node;  // the same square in *this, or -1 where *this has a leaf above it
+    int depth;
+    double share;  // the square's share of the energy
+  };
+  std::vector<Pending> stack{{0, 0, 1, 1.0}};
+  while (!stack.empty()) {
+    const Pending at = stack.back();
+    stack.pop_back();
+    for (int q = 0; q < 4; ++q) {
+      double share = at.share / 4;  // a leaf's energy, spread evenly over its quadrants
+      int64_t old_child = -1;
+      if (at.old_node >= 0) {
+        const Node& old = nodes_[size_t(at.old_node)];
+        share = old.energy[q] / whole;
+        if (old.child[q]) old_child = old.child[q];
+      }
+      if (share > rho && at.depth<max_depth&& * node_budget> 0) {
+        --*node_budget;
+        const uint32_t child = uint32_t(out.nodes_.size());
+        out.nodes_.emplace_back();
+        out.nodes_[at.node].child[q] = child;
+        stack.push_back({child, old_child, at.depth + 1, share});
+      }
+    }
+  }
+  return out;
+}
+
+int DirectionalQuadtree::depth() const {
+  std::vector<int> level(nodes_.size(), 1);
+  int deepest = 1;
+  for (size_t i = 0; i < nodes_.size(); ++i) {
+    deepest = std::max(deepest, level[i]);
+    for (uint32_t c : nodes_[i].child)
+      if (c) level[c] = level[i] + 1;
+  }
+  return deepest;
+}
+
+}  // namespace caustica

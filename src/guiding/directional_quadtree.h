@@ -1,0 +1,67 @@
+// The directional part of Müller et al. 2017, "Practical Path Guiding for Efficient
+// Light-Transport Simulation" (sec. 3.3): a quadtree over the square of cylindrical
+// coordinates (cos theta, phi) of world directions. The mapping is area preserving (Archimedes'
+// hat-box theorem), so the solid-angle density of a direction is its density on the unit square
+// divided by 4 pi: pdf(w) = (energy fraction of its leaf / area of the leaf) / (4 pi).
+//
+// Each node splits its square into four quadrants (index ix + 2 iy, ix = x >= 1/2); a quadrant
+// is a leaf (child 0) or an inner node. A node stores the energy of each quadrant; recording adds
+// to leaf quadrants only and propagate() fills the inner sums, so splatting order does not
+// change the structure (and, splatted in a fixed order, not the sums either).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/vec.h"
+
+namespace caustica {
+
+// Unit square <-> unit direction: u = (cos theta + 1) / 2, v = phi / (2 pi).
+Vec2 direction_to_square(Vec3 w);
+Vec3 square_to_direction(Vec2 p);
+
+class DirectionalQuadtree {
+ public:
+  struct Node {
+    std::array<double, 4> energy{};   // per quadrant: recorded flux (inner: sum of its subtree)
+    std::array<uint32_t, 4> child{};  // 0: the quadrant is a leaf
+  };
+
+  // One node: four uniform leaf quadrants.
+  DirectionalQuadtree() : nodes_(1) {}
+
+  // Sum of the recorded energy (after propagate()).
+  double total() const;
+  // Adds `value` to the leaf quadrant holding p (a point of the unit square). propagate()
+  // afterwards, before sampling.
+  void record(Vec2 p, double value);
+  // Recomputes inner nodes' energies from the leaves (bottom up).
+  void propagate();
+
+  // Density on the unit square at p; 0 everywhere if total() == 0. Solid angle: pdf / (4 pi).
+  float pdf_square(Vec2 p) const;
+  float pdf(Vec3 w) const;
+  // Hierarchical sample warping (Müller et al. 2017, sec. 3.3 and its appendix): u picks a
+  // quadrant per level and is rescaled; requires total() > 0.
+  Vec2 sample_square(Vec2 u) const;
+  Vec3 sample(Vec2 u) const { return square_to_direction(sample_square(u)); }
+
+  // The structure for the next training iteration (Müller et al. 2017, sec. 3.4): a quadrant is
+  // subdivided where its share of the total energy exceeds rho (a leaf's share split evenly
+  // among its would-be children), up to max_depth levels; everything else collapses. The
+  // energies of the result are zero. At most *node_budget nodes are created (beyond the root),
+  // and *node_budget is decremented by what was.
+  DirectionalQuadtree refined(double rho, int max_depth, size_t* node_budget) const;
+
+  size_t node_count() const { return nodes_.size(); }
+  int depth() const;
+  static constexpr size_t kNodeBytes = sizeof(Node);
+
+ private:
+  std::vector<Node> nodes_;  // nodes_[0] is the root; children come after their parents
+};
+
+}  // namespace caustica

@@ -1,0 +1,199 @@
+// The learned radiance field of path guiding (guiding/, after Müller et al. 2017): its
+// directional distribution is a density over the sphere whose samples follow it, trained on a
+// known radiance field it learns that field, and its memory stays under the cap. guided-pt's
+// furnace, agreement with pt and thread determinism come from the registry oracles.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "chi2.h"
+#include "core/math.h"
+#include "guiding/guiding_field.h"
+#include "integrators/guided_path_tracer.h"
+#include "io/builtin_scenes.h"
+#include "test_scenes.h"
+
+using namespace caustica;
+
+namespace {
+
+// A synthetic incident radiance field: `inside` within a cone of half-angle `angle` around
+// `axis`, 1 elsewhere.
+struct ConeField {
+  Vec3 axis;
+  float cos_angle;
+  float inside;
+  float radiance(Vec3 w) const { return dot(w, axis) >= cos_angle ? inside : 1.f; }
+  // The share of the sphere's incident energy inside the cone.
+  double cone_fraction() const {
+    const double cone = 2 * kPi * (1 - double(cos_angle));
+    return inside * cone / (inside * cone + (4 * kPi - cone));
+  }
+};
+
+// Trains field at point p for `iterations` doubling iterations of `base` samples each, drawing
+// directions from the mixture the integrator uses (half learned, half uniform on the sphere) and
+// splatting radiance / pdf.
+void train(GuidingField& field, const std::function<ConeField(Vec3)>& scene, int iterations,
+           int base, uint64_t seed) {
+  Pcg32 rng(seed, 11);
+  for (int k = 0; k < iterations; ++k) {
+    for (int i = 0; i < (base << k); ++i) {
+      const Vec3 p(rng.next_float(), rng.next_float(), rng.next_float());
+      const DirectionalQuadtree& learned = field.sampling(field.leaf_at(p));
+      const bool guided = learned.total() > 0;
+      const Vec2 u = rng.next_2d();
+      const Vec3 w = guided && rng.next_float() < 0.5f ? learned.sample(u) : square_to_direction(u);
+      const float pdf = guided ? 0.5f * kInv4Pi + 0.5f * learned.pdf(w) : kInv4Pi;
+      field.record({p, w, scene(p).radiance(w) / pdf});
+    }
+    field.end_iteration(k);
+  }
+}
+
+GuidingField trained_cone(const ConeField& cone, int iterations = 6,
+                          const GuidingSettings& settings = {}) {
+  GuidingField field(Bounds3{{0, 0, 0}, {1, 1, 1}}, settings);
+  train(
+      field, [&](Vec3) { return cone; }, iterations, 20000, 3);
+  return field;
+}
+
+const ConeField kCone{normalize(Vec3(0.3f, -0.5f, 0.8f)), std::cos(radians(15.f)), 100.f};
+
+}  // namespace
+
+TEST(Guiding, CylindricalMappingRoundTrips) {
+  Pcg32 rng(1, 2);
+  for (int i = 0; i < 1000; ++i) {
+    const Vec2 p = rng.next_2d();
+    const Vec2 q = direction_to_square(square_to_direction(p));
+    EXPECT_NEAR(p.x, q.x, 1e-5f);
+    EXPECT_NEAR(p.y, q.y, 1e-5f);
+  }
+}
+
+// A density over the sphere: its integral (quadrature on a fine (cos theta, phi) grid whose
+// cells the quadtree's dyadic leaves align with) is 1.
+TEST(Guiding, LearnedDistributionIntegratesToOne) {
+  const GuidingField field = trained_cone(kCone);
+  const DirectionalQuadtree& d = field.sampling(field.leaf_at({0.5f, 0.5f, 0.5f}));
+  ASSERT_GT(d.total(), 0);
+  EXPECT_GT(d.depth(), 3) << "the test should see a refined tree";
+  const double integral =
+      test::integrate_sphere([&](Vec3 w) { return double(d.pdf(w)); }, 512, 1024);
+  EXPECT_NEAR(integral, 1.0, 2e-3);
+}
+
+// Chi-square goodness of fit of sample() against pdf() (tests/chi2.h).
+TEST(Guiding, SamplingFollowsPdfChiSquare) {
+  const GuidingField field = trained_cone(kCone);
+  const DirectionalQuadtree& d = field.sampling(field.leaf_at({0.5f, 0.5f, 0.5f}));
+  test::Chi2Options o;
+  o.theta_bins = 20;
+  o.phi_bins = 40;
+  o.sample_count = 400000;
+  const auto r = test::chi2_test(
+      [&](Pcg32& rng) -> std::optional<test::DirectionSample> {
+        const Vec3 w = d.sample(rng.next_2d());
+        return test::DirectionSample{w, d.pdf(w)};
+      },
+      [&](Vec3 w) { return d.pdf(w); }, o);
+  EXPECT_TRUE(r.passed) << r.message << " p " << r.p_value;
+}
+
+// Trained on radiance concentrated in a cone, the learned density is much higher in the cone
+// than outside, and the cone's probability tends to its share of the energy as the quadtree
+// refines (smaller rho): leaves straddling the cone's rim spread its energy outside.
+TEST(Guiding, LearnsARadianceCone) {
+  auto cone_probability = [](double rho, int iterations) {
+    GuidingSettings s;
+    s.rho = rho;
+    const GuidingField field = trained_cone(kCone, iterations, s);
+    const DirectionalQuadtree& d = field.sampling(field.leaf_at({0.5f, 0.5f, 0.5f}));
+    EXPECT_GT(d.pdf(kCone.axis), 50 * d.pdf(-kCone.axis));
+    const double p = test::integrate_sphere(
+        [&](Vec3 w) { return dot(w, kCone.axis) >= kCone.cos_angle ? double(d.pdf(w)) : 0.0; }, 512,
+        1024);
+    std::printf("[ guiding ] rho %.4f, %d iterations: cone probability %.4f (share %.4f)\n", rho,
+                iterations, p, kCone.cone_fraction());
+    return p;
+  };
+  const double coarse = cone_probability(0.01, 6), fine = cone_probability(0.001, 8);
+  EXPECT_LT(std::abs(fine - kCone.cone_fraction()), 0.5 * std::abs(coarse - kCone.cone_fraction()));
+  EXPECT_NEAR(coarse, kCone.cone_fraction(), 0.06);
+  EXPECT_NEAR(fine, kCone.cone_fraction(), 0.02);
+  // Before training it knows nothing (and is not used).
+  EXPECT_EQ(GuidingField().sampling(0).total(), 0);
+}
+
+// Two halves of space with light from different cones: the spatial tree splits (with a low
+// threshold c) and each side learns its own cone.
+TEST(Guiding, SpatialTreeSeparatesRegions) {
+  GuidingSettings s;
+  s.spatial_threshold = 2000;
+  GuidingField field(Bounds3{{0, 0, 0}, {2, 1, 1}}, s);  // x is the longest axis
+  const ConeField left = kCone, right{-kCone.axis, kCone.cos_angle, 100.f};
+  train(
+      field, [&](Vec3 p) { return p.x < 0.5f ? left : right; }, 6, 20000, 5);
+  // Training points are in the unit cube: x < 0.5 is left, x in [0.5, 1) right.
+  EXPECT_GT(field.leaf_count(), 2u);
+  const DirectionalQuadtree& a = field.sampling(field.leaf_at({0.2f, 0.5f, 0.5f}));
+  const DirectionalQuadtree& b = field.sampling(field.leaf_at({0.8f, 0.5f, 0.5f}));
+  EXPECT_GT(a.pdf(left.axis), 20 * a.pdf(right.axis));
+  EXPECT_GT(b.pdf(right.axis), 20 * b.pdf(left.axis));
+}
+
+// The memory cap bounds the directional nodes of all leaves together, and memory is reported.
+TEST(Guiding, NodeCapBoundsMemory) {
+  GuidingSettings s;
+  s.spatial_threshold = 500;
+  s.max_quadtree_nodes = 300;
+  GuidingField field(Bounds3{{0, 0, 0}, {1, 1, 1}}, s);
+  train(
+      field, [&](Vec3) { return kCone; }, 5, 20000, 7);
+  EXPECT_LE(field.quadtree_node_count(), s.max_quadtree_nodes);
+  EXPECT_GT(field.quadtree_node_count(), s.max_quadtree_nodes / 2) << "the cap was reached";
+  EXPECT_GE(field.memory_bytes(), field.quadtree_node_count() * DirectionalQuadtree::kNodeBytes);
+}
+
+TEST(GuidedPathTracer, TrainingPassesDoubleInLength) {
+  const int expected[] = {0, 1, 1, 2, 2, 2, 2, 3, 3};
+  for (uint32_t i = 0; i < 9; ++i) EXPECT_EQ(GuidedPathTracer::training_pass(i), expected[i]);
+  EXPECT_EQ(GuidedPathTracer::training_pass(14), 3);
+  EXPECT_EQ(GuidedPathTracer::training_pass(15), 4);
+}
+
+// Rendering trains the field: after 15 iterations (passes 0..3) it has learned radiance and
+// refined its quadtrees; the statistics report it.
+TEST(GuidedPathTracer, RenderingTrainsTheField) {
+  auto scene = make_builtin_scene("cornell", 32, 32);
+  IntegratorSettings settings;
+  GuidedPathTracer integrator(settings);
+  RenderBudget budget;
+  budget.spp = 15;
+  RenderCallbacks cb;
+  cb.quiet = true;
+  render(*scene, integrator, budget, cb);
+  const GuidingField& field = integrator.field();
+  const DirectionalQuadtree& d = field.sampling(field.leaf_at(scene->bounds().center()));
+  EXPECT_GT(d.total(), 0);
+  EXPECT_GT(d.node_count(), 1u);
+  nlohmann::json stats;
+  integrator.report(stats);
+  EXPECT_EQ(stats["guiding"]["training_passes_completed"], 3);
+  EXPECT_GT(stats["guiding"]["guiding_bytes"].get<size_t>(), 0u);
+}
+
+// The registry's determinism oracle renders 3 iterations (one splat feeds the sampling); here
+// passes 0..3 sample with fields learned from multi-threaded splats: still bit-identical.
+TEST(GuidedPathTracer, TrainedFieldBitIdenticalForOneAndTwoThreads) {
+  auto scene = make_builtin_scene("cornell", 24, 24);
+  const auto a = test::render_with(*scene, "guided-pt", 12, {}, 1);
+  const auto b = test::render_with(*scene, "guided-pt", 12, {}, 2);
+  size_t differing = 0;
+  for (size_t i = 0; i < a.image.pixel_count(); ++i)
+    if (!(a.image[i] == b.image[i])) ++differing;
+  EXPECT_EQ(differing, 0u);
+}

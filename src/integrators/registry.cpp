@@ -32,6 +32,7 @@ std::vector<IntegratorInfo> make_registry() {
                "path tracing guided by incident radiance learned while rendering (Mueller 2017)",
                true, true, false, MisHeuristic::Power,
                [](const IntegratorSettings& s) { return std::make_unique<GuidedPathTracer>(s); }});
+  r.back().learns_while_rendering = true;
   return r;
 }
 

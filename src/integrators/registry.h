@@ -27,6 +27,10 @@ struct IntegratorInfo {
   bool caustics_through_specular = false;
   MisHeuristic default_mis = MisHeuristic::Balance;  // when the user names none (--mis)
   std::function<std::unique_ptr<Integrator>(const IntegratorSettings&)> make;
+  // Learns from its own samples while rendering (path guiding): its image depends on every
+  // earlier iteration, so it cannot be split over MPI ranks until the learned structures are
+  // merged across ranks (not done yet); the command line refuses it with several ranks.
+  bool learns_while_rendering = false;
 };
 
 // In the order the README documents them.

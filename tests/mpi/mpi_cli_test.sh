@@ -6,6 +6,9 @@
 #       --time with checkpoints: one set of files (exr, png, json), iterations summed over ranks
 #   mpi_cli_test.sh MPIEXEC CAUSTICA WORKDIR rank-fails
 #       rank 1 gets a scene file that does not exist: every rank stops, exit code 2, one message
+#   mpi_cli_test.sh MPIEXEC CAUSTICA WORKDIR learning-refused
+#       an integrator that learns while rendering (guided-pt) is refused with 2 ranks: exit 2,
+#       one message, no files; with one process it renders
 set -u
 mpiexec=$1 caustica=$2 work=$3 mode=$4
 rm -rf "$work" && mkdir -p "$work" || exit 1
@@ -53,6 +56,16 @@ rank-fails)
   [ "$(grep -c . err.txt)" -eq 1 ] || fail "expected exactly one line on stderr"
   grep -q "^caustica: error: rank 1 of 2: .*missing.pbrt" err.txt || fail "message does not name rank 1 and the file"
   ls ok.* >/dev/null 2>&1 && fail "files were written"
+  ;;
+learning-refused)
+  mpi -np 2 "$caustica" render --integrator guided-pt --spp 2 $common --outfile no 2>err.txt
+  rc=$?
+  cat err.txt
+  [ $rc -eq 2 ] || fail "exit code $rc, expected 2"
+  [ "$(grep -c . err.txt)" -eq 1 ] || fail "expected exactly one line on stderr"
+  grep -q "guided-pt learns while it renders" err.txt || fail "message does not say why"
+  ls no.* >/dev/null 2>&1 && fail "files were written"
+  "$caustica" render --integrator guided-pt --spp 2 $common --outfile yes || fail "one process"
   ;;
 *) fail "unknown mode $mode" ;;
 esac

@@ -129,7 +129,6 @@ class HostileCli : public testing::TestWithParam<size_t> {};
 
 TEST_P(HostileCli, RefusedBeforeRenderingWithOneLineExit2AndNoFiles) {
   const HostileCase& c = cases()[GetParam()];
-  if (c.needs_non_root && ::geteuid() == 0) GTEST_SKIP() << "root ignores permission bits";
   const fs::path d = cli_test::fresh_dir("hostile_" + std::to_string(GetParam()));
   if (c.setup) c.setup(d);
   std::set<std::string> before = cli_test::entries(d);
@@ -161,6 +160,15 @@ std::string case_name(const testing::TestParamInfo<size_t>& info) {
   return name;
 }
 
-INSTANTIATE_TEST_SUITE_P(Table, HostileCli, testing::Range(size_t(0), cases().size()), case_name);
+// The rows that can run here: permission bits do not stop root, so a read-only folder is only a
+// case for other users (the /proc row covers an unwritable folder for root).
+std::vector<size_t> applicable_cases() {
+  std::vector<size_t> rows;
+  for (size_t i = 0; i < cases().size(); ++i)
+    if (!(cases()[i].needs_non_root && ::geteuid() == 0)) rows.push_back(i);
+  return rows;
+}
+
+INSTANTIATE_TEST_SUITE_P(Table, HostileCli, testing::ValuesIn(applicable_cases()), case_name);
 
 }  // namespace

@@ -49,18 +49,6 @@ BandMeans band_means(const Image& img, int band) {
   return {b / double(nb), i / double(ni)};
 }
 
-// Mean and standard error of a statistic over independent seeds.
-template <typename Fn>
-std::pair<double, double> over_seeds(int runs, Fn&& fn) {
-  std::vector<double> v;
-  for (int k = 0; k < runs; ++k) v.push_back(fn(uint64_t(100 + k)));
-  double m = 0, s = 0;
-  for (double x : v) m += x;
-  m /= runs;
-  for (double x : v) s += (x - m) * (x - m);
-  return {m, std::sqrt(s / (runs - 1) / runs)};
-}
-
 }  // namespace
 
 // --- 1. Thin lens -------------------------------------------------------------------------------

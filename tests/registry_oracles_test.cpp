@@ -18,26 +18,19 @@ using namespace caustica::test;
 
 namespace {
 
-// Mean image value over `runs` independent renders (seeds), and its standard error from the
-// spread of the per-run means: valid even though bidirectional pixels share light paths.
-struct RunStats {
-  double mean = 0, standard_error = 0;
-};
-RunStats stats_over_seeds(const Scene& scene, const std::string& integrator, int spp,
-                          IntegratorSettings s, int runs) {
-  std::vector<double> means;
-  for (int k = 0; k < runs; ++k) {
-    s.seed = 1000 + k;
-    const auto r = render_with(scene, integrator, spp, s);
-    EXPECT_EQ(r.nonfinite, 0u) << integrator;
-    means.push_back(pixel_stats(r.image).mean);
-  }
-  double m = 0, v = 0;
-  for (double x : means) m += x;
-  m /= runs;
-  for (double x : means) v += (x - m) * (x - m);
-  v /= (runs - 1);
-  return {m, std::sqrt(v / runs)};
+// Mean image value over `runs` independent renders (seeds 1000, 1001, ...) and its standard
+// error (test_scenes.h).
+SeedStats stats_over_seeds(const Scene& scene, const std::string& integrator, int spp,
+                           IntegratorSettings s, int runs) {
+  return over_seeds(
+      runs,
+      [&](uint64_t seed) {
+        s.seed = seed;
+        const auto r = render_with(scene, integrator, spp, s);
+        EXPECT_EQ(r.nonfinite, 0u) << integrator;
+        return pixel_stats(r.image).mean;
+      },
+      1000);
 }
 
 Image add(const Image& a, const Image& b) {
@@ -73,7 +66,7 @@ TEST_P(RegistryOracle, FurnaceMatchesAnalyticRadiance) {
   s.max_depth = 200;
   s.bidir.radius = info().unbiased ? 0.05f : 0.1f;
   const int spp = 8;
-  const RunStats st = stats_over_seeds(*scene, GetParam(), spp, s, 6);
+  const SeedStats st = stats_over_seeds(*scene, GetParam(), spp, s, 6);
   const double shrink = std::pow(double(spp), s.bidir.radius_alpha - 1.0);  // (r_i / r_1)^2
   const double bias = info().unbiased ? 0.0 : 0.01 * shrink * p.expected_radiance();
   std::printf("[ furnace ] %-4s mean %.5f se %.5f (expected %.5f)\n", GetParam().c_str(), st.mean,
@@ -88,7 +81,7 @@ TEST_P(RegistryOracle, EnvironmentFurnaceIsInvisible) {
   IntegratorSettings s;
   s.max_depth = 200;
   s.bidir.radius = 0.05f;
-  const RunStats st = stats_over_seeds(*scene, GetParam(), 4, s, 4);
+  const SeedStats st = stats_over_seeds(*scene, GetParam(), 4, s, 4);
   EXPECT_NEAR(st.mean, 1.0, 3 * st.standard_error + (info().unbiased ? 1e-5 : 0.01))
       << " se " << st.standard_error;
 }

@@ -3,8 +3,10 @@
 
 #include <tbb/global_control.h>
 
+#include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "image/image.h"
 #include "integrators/registry.h"
@@ -46,6 +48,23 @@ inline PixelStats pixel_stats(const Image& img) {
   const double mean = s / n;
   const double var = std::max(0.0, s2 / n - mean * mean) * n / (n - 1);
   return {mean, std::sqrt(var / n), mn, mx};
+}
+
+// Mean and standard error of a statistic over independent renders: fn(seed) for `runs` seeds
+// from first_seed on. The standard error comes from the spread of the per-run values, so it is
+// valid even when pixels of one render are correlated (bidirectional pixels share light paths).
+struct SeedStats {
+  double mean = 0, standard_error = 0;
+};
+template <typename Fn>
+SeedStats over_seeds(int runs, Fn&& fn, uint64_t first_seed = 100) {
+  std::vector<double> v;
+  for (int k = 0; k < runs; ++k) v.push_back(fn(first_seed + uint64_t(k)));
+  double m = 0, s = 0;
+  for (double x : v) m += x;
+  m /= runs;
+  for (double x : v) s += (x - m) * (x - m);
+  return {m, std::sqrt(s / (runs - 1) / runs)};
 }
 
 }  // namespace caustica::test

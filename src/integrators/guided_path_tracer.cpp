@@ -95,20 +95,8 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
 
   for (;;) {
     SurfaceInteraction si;
-    if (!scene.intersect(ray, &si)) {
-      add_emission(nullptr);
-      break;
-    }
-    add_emission(&si);
-    if (!si.material) {
-      ray = si.spawn_ray(ray.d);
-      continue;
-    }
-    const Bsdf bsdf = si.material->bsdf(si, arena);
-    if (!bsdf.valid()) {
-      ray = si.spawn_ray(ray.d);
-      continue;
-    }
+    Bsdf bsdf;
+    if (!next_scattering_vertex(scene, ray, arena, &si, &bsdf, add_emission)) break;
     if (depth++ == settings_.max_depth) break;
 
     const Vec3 wo = si.wo;
@@ -125,15 +113,8 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
 
     const float u_light = rng.next_float();
     const Vec2 u = rng.next_2d();
-    if (!bsdf.is_delta() && !lights.empty()) {
-      if (const auto d = sample_direct_light(scene, si, bsdf, u_light, u)) {
-        if (!scene.occluded(d->shadow)) {
-          const float light_pdf = d->pmf * d->ls.pdf_w;
-          const float w = d->light->is_delta() ? 1.f : mis_weight(light_pdf, mixture_pdf(d->ls.wi));
-          add(beta * d->f * d->ls.radiance * (w / light_pdf));
-        }
-      }
-    }
+    add(direct_light_mis(scene, si, bsdf, beta, u_light, u, mixture_pdf,
+                         [&](float a, float b) { return mis_weight(a, b); }));
 
     const float uc = rng.next_float();
     const Vec2 u_dir = rng.next_2d();

@@ -37,21 +37,8 @@ Rgb PathTracer::radiance(const Scene& scene, const Ray& camera_ray, Pcg32& rng,
 
   for (;;) {
     SurfaceInteraction si;
-    if (!scene.intersect(ray, &si)) {
-      add_emission(nullptr);
-      break;
-    }
-    add_emission(&si);
-
-    if (!si.material) {  // an interface without scattering: continue straight through
-      ray = si.spawn_ray(ray.d);
-      continue;
-    }
-    const Bsdf bsdf = si.material->bsdf(si, arena);
-    if (!bsdf.valid()) {
-      ray = si.spawn_ray(ray.d);
-      continue;
-    }
+    Bsdf bsdf;
+    if (!next_scattering_vertex(scene, ray, arena, &si, &bsdf, add_emission)) break;
     if (depth++ == settings_.max_depth) break;
 
     const Vec3 wo = si.wo;
@@ -59,18 +46,10 @@ Rgb PathTracer::radiance(const Scene& scene, const Ray& camera_ray, Pcg32& rng,
     // the random numbers are drawn anyway to keep the stream aligned across vertex kinds).
     const float u_light = rng.next_float();
     const Vec2 u = rng.next_2d();
-    if (!bsdf.is_delta() && !lights.empty()) {
-      if (const auto d = sample_direct_light(scene, si, bsdf, u_light, u)) {
-        if (!scene.occluded(d->shadow)) {
-          const float light_pdf = d->pmf * d->ls.pdf_w;
-          const float w =
-              d->light->is_delta()
-                  ? 1.f
-                  : mis_weight(light_pdf, bsdf.pdf(wo, d->ls.wi, TransportMode::Radiance));
-          L += beta * d->f * d->ls.radiance * (w / light_pdf);
-        }
-      }
-    }
+    L += direct_light_mis(
+        scene, si, bsdf, beta, u_light, u,
+        [&](Vec3 wi) { return bsdf.pdf(wo, wi, TransportMode::Radiance); },
+        [&](float a, float b) { return mis_weight(a, b); });
 
     const float uc = rng.next_float();
     const auto bs = bsdf.sample(wo, uc, rng.next_2d(), TransportMode::Radiance);

@@ -13,12 +13,12 @@
 #include "core/rng.h"
 #include "geometry/interaction.h"
 #include "lights/light.h"
+#include "lights/light_sampler.h"
 #include "materials/bsdf.h"
+#include "materials/material.h"
+#include "scene/scene.h"
 
 namespace caustica {
-
-class Scene;
-class LightSampler;
 
 // The emitters a camera ray reaches: with hit == nullptr (the ray escaped) every infinite light
 // along ray.d, else the area light of the hit primitive. fn(const Light&, Rgb Le) for each
@@ -57,6 +57,43 @@ struct DirectLightSample {
 std::optional<DirectLightSample> sample_direct_light(const Scene& scene,
                                                      const SurfaceInteraction& si, const Bsdf& bsdf,
                                                      float u_light, Vec2 u);
+
+// Follows `ray` to the next vertex that scatters: through interfaces (no material, or a material
+// with no BSDF there) it goes straight on. on_emission(hit) is called for every surface reached
+// (hit != nullptr) and, with nullptr, when the ray escapes; then it returns false. On true, si
+// and bsdf describe the vertex (bsdf allocated in arena).
+template <typename OnEmission>
+bool next_scattering_vertex(const Scene& scene, Ray& ray, ScratchArena& arena,
+                            SurfaceInteraction* si, Bsdf* bsdf, OnEmission&& on_emission) {
+  for (;;) {
+    if (!scene.intersect(ray, si)) {
+      on_emission(nullptr);
+      return false;
+    }
+    on_emission(si);
+    if (si->material) {
+      *bsdf = si->material->bsdf(*si, arena);
+      if (bsdf->valid()) return true;
+    }
+    ray = si->spawn_ray(ray.d);
+  }
+}
+
+// Next event estimation with MIS against BSDF-side sampling, as unidirectional camera paths do
+// it: beta * f * Le * w / p_light for an unoccluded light sample, else black (also for delta
+// BSDFs and light-less scenes). sampling_pdf(wi) is the solid-angle density with which the
+// path's own direction sampling would pick wi; mis(p_light, p_sampling) the heuristic; delta
+// lights get weight 1.
+template <typename SamplingPdf, typename Mis>
+Rgb direct_light_mis(const Scene& scene, const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
+                     float u_light, Vec2 u, SamplingPdf&& sampling_pdf, Mis&& mis) {
+  if (bsdf.is_delta() || scene.light_sampler().empty()) return Rgb(0.f);
+  const auto d = sample_direct_light(scene, si, bsdf, u_light, u);
+  if (!d || scene.occluded(d->shadow)) return Rgb(0.f);
+  const float light_pdf = d->pmf * d->ls.pdf_w;
+  const float w = d->light->is_delta() ? 1.f : mis(light_pdf, sampling_pdf(d->ls.wi));
+  return beta * d->f * d->ls.radiance * (w / light_pdf);
+}
 
 // Russian roulette after `depth` scattering vertices, on the throughput with the radiance
 // scaling of refraction (eta_scale) removed, never before the second vertex. Returns false when

@@ -9,6 +9,31 @@
 
 namespace caustica::cli {
 
+namespace {
+
+// Path guiding (guided-pt): src/guiding/guiding_settings.h has the meaning of each.
+void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
+  o.number("--guiding-spatial-threshold", &s->guiding.spatial_threshold, 0, 1e12, true,
+           "Guiding: split a spatial leaf after c sqrt(2^k) path vertices in training pass k "
+           "(default c = 12000, Mueller 2017)");
+  o.number("--guiding-rho", &s->guiding.rho, 0, 1, true,
+           "Guiding: refine a directional quadrant holding more than this share of the energy "
+           "(default 0.01)");
+  o.integer("--guiding-max-mb", &s->guiding_max_mb, 1, 65536,
+            "Guiding: memory cap of the learned structure in MiB (default 32)");
+  o.number("--guiding-bsdf-fraction", &s->guiding.bsdf_fraction, 0, 1, false,
+           "Guiding: fixed probability of sampling the BSDF instead of the learned distribution "
+           "(default: learned per spatial leaf by Adam, Mueller 2019)");
+  o.choice("--guiding-filter", &s->guiding_filter, {"on", "off"},
+           "Guiding: box-filtered splatting into the spatial and directional trees, on or off "
+           "(default on)");
+  o.choice("--guiding-combine", &s->guiding_combine, {"inverse-variance", "equal"},
+           "Guiding: weight the training passes in the image by inverse variance, or every "
+           "iteration equally (default inverse-variance)");
+}
+
+}  // namespace
+
 CLI::Option* add_shared_options(CheckedOptions& o, SharedOptions* s, const std::string& time_help) {
   CLI::Option* time =
       o.number("--time", &s->seconds, 0, kMaxSeconds, true, time_help + ", at most 30 days");
@@ -37,6 +62,7 @@ CLI::Option* add_shared_options(CheckedOptions& o, SharedOptions* s, const std::
            "Photon mapping / VCM: radius reduction alpha in (0, 1] (default 0.75)");
   o.text("--techniques", &s->bidir.techniques_dir,
          "Bidirectional: write one weighted image per technique to DIR");
+  add_guiding_options(o, s);
   return time;
 }
 
@@ -84,6 +110,10 @@ int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene,
   if (!s.mis.empty())
     settings->mis = s.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
   settings->bidir = s.bidir;
+  settings->guiding = s.guiding;
+  settings->guiding.max_bytes = size_t(s.guiding_max_mb) << 20;
+  settings->guiding.filter = s.guiding_filter == "on";
+  settings->guiding.inverse_variance = s.guiding_combine == "inverse-variance";
   return 0;
 }
 

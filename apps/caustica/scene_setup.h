@@ -23,6 +23,11 @@ struct SceneSetup {
   // Integrator options (every rendering subcommand takes them; integrators that do not use one
   // ignore it).
   BidirSettings bidir;  // --light-paths, --radius, --radius-alpha, --techniques
+  // --guiding-spatial-threshold, --guiding-rho, --guiding-bsdf-fraction; the others below.
+  GuidingSettings guiding;
+  int guiding_max_mb = 32;                           // --guiding-max-mb
+  std::string guiding_filter = "on";                 // --guiding-filter
+  std::string guiding_combine = "inverse-variance";  // --guiding-combine
 };
 
 // The options render, reference and compare share, with the ranges they all obey.
@@ -37,7 +42,7 @@ constexpr double kMaxSeconds = 30 * 24 * 3600;
 
 // Registers --time (with the command's help text; returned so it can be made required),
 // --threads, --max-depth, --seed, --resolution, --mis, --camera and the integrator options
-// --light-paths, --radius, --radius-alpha and --techniques.
+// --light-paths, --radius, --radius-alpha, --techniques and --guiding-*.
 CLI::Option* add_shared_options(CheckedOptions& options, SharedOptions* shared,
                                 const std::string& time_help);
 

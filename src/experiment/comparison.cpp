@@ -68,7 +68,8 @@ ComparisonResult run_comparison(const Scene& scene, const Image& reference,
     cb.quiet = true;
     cb.on_iteration = [&](const Film& film, uint32_t iterations, double seconds) {
       if (seconds >= next_snapshot) {
-        run.snapshots.push_back({seconds, iterations, compute_errors(film.image(), reference)});
+        run.snapshots.push_back(
+            {seconds, iterations, compute_errors(integrator->image(film), reference)});
         while (next_snapshot <= seconds) next_snapshot *= 2;
       }
       if (progress)

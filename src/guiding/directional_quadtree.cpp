@@ -1,5 +1,6 @@
 #include "guiding/directional_quadtree.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/math.h"
@@ -42,6 +43,54 @@ void DirectionalQuadtree::record(Vec2 p, double value) {
       return;
     }
     node = child;
+  }
+}
+
+double DirectionalQuadtree::leaf_size(Vec2 p) const {
+  double x = p.x, y = p.y, size = 1;
+  uint32_t node = 0;
+  for (;;) {
+    const int ix = x >= 0.5, iy = y >= 0.5;
+    x = 2 * x - ix;
+    y = 2 * y - iy;
+    size *= 0.5;
+    const uint32_t child = nodes_[node].child[ix + 2 * iy];
+    if (!child) return size;
+    node = child;
+  }
+}
+
+void DirectionalQuadtree::record_filtered(Vec2 p, double value) {
+  const double size = leaf_size(p), density = value / (size * size);
+  const double x0 = std::clamp(double(p.x) - size / 2, 0.0, 1.0 - size);
+  const double y0 = double(p.y) - size / 2, y1 = y0 + size;
+  auto splat = [&](double lo, double hi) {
+    const double box[4] = {x0, x0 + size, lo, hi};
+    if (hi > lo) record_box(0, 0, 0, 1, box, density);
+  };
+  if (y0 < 0) {  // phi wraps around
+    splat(0, y1);
+    splat(1 + y0, 1);
+  } else if (y1 > 1) {
+    splat(y0, 1);
+    splat(0, y1 - 1);
+  } else {
+    splat(y0, y1);
+  }
+}
+
+void DirectionalQuadtree::record_box(uint32_t node, double ox, double oy, double size,
+                                     const double box[4], double density) {
+  const double half = size / 2;
+  for (int q = 0; q < 4; ++q) {
+    const double qx = ox + (q & 1) * half, qy = oy + (q >> 1) * half;
+    const double w = std::min(box[1], qx + half) - std::max(box[0], qx);
+    const double h = std::min(box[3], qy + half) - std::max(box[2], qy);
+    if (!(w > 0 && h > 0)) continue;
+    if (const uint32_t child = nodes_[node].child[q])
+      record_box(child, qx, qy, half, box, density);
+    else
+      nodes_[node].energy[q] += density * w * h;
   }
 }
 

@@ -38,6 +38,11 @@ class DirectionalQuadtree {
   // Adds `value` to the leaf quadrant holding p (a point of the unit square). propagate()
   // afterwards, before sampling.
   void record(Vec2 p, double value);
+  // Box-filtered recording (Müller 2019, "Practical Path Guiding in Production", sec. on
+  // filtering): `value` is spread over a square of the side of the leaf quadrant holding p,
+  // centred at p, in proportion to its overlap with each leaf quadrant. The square is moved
+  // inside the unit square in u (cos theta) and wraps around in v (phi), so no energy is lost.
+  void record_filtered(Vec2 p, double value);
   // Recomputes inner nodes' energies from the leaves (bottom up).
   void propagate();
 
@@ -57,10 +62,19 @@ class DirectionalQuadtree {
   DirectionalQuadtree refined(double rho, int max_depth, size_t* node_budget) const;
 
   size_t node_count() const { return nodes_.size(); }
+  size_t bytes() const { return nodes_.capacity() * sizeof(Node); }
+  void shrink_to_fit() { nodes_.shrink_to_fit(); }
   int depth() const;
   static constexpr size_t kNodeBytes = sizeof(Node);
 
  private:
+  // Adds density * (overlap area) of the box [x0, x1) x [y0, y1) to the leaf quadrants under
+  // `node`, whose square has corner (ox, oy) and side `size`.
+  void record_box(uint32_t node, double ox, double oy, double size, const double box[4],
+                  double density);
+  // Side of the leaf quadrant holding p.
+  double leaf_size(Vec2 p) const;
+
   std::vector<Node> nodes_;  // nodes_[0] is the root; children come after their parents
 };
 

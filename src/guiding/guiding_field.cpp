@@ -1,15 +1,23 @@
 #include "guiding/guiding_field.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
 #include <cmath>
 
 namespace caustica {
 
-GuidingField::GuidingField(Bounds3 bounds, const GuidingSettings& settings) : settings_(settings) {
-  if (bounds.empty()) bounds = Bounds3{{0, 0, 0}, {1, 1, 1}};
-  SpatialNode root;
-  root.box = bounds;
-  nodes_.push_back(root);
+GuidingField::GuidingField(Bounds3 bounds, const GuidingSettings& settings)
+    : settings_(settings), bounds_(bounds.empty() ? Bounds3{{0, 0, 0}, {1, 1, 1}} : bounds) {
+  nodes_.emplace_back();
   leaves_.emplace_back();
+  leaves_[0].box = bounds_;
+  reset_counts();
+}
+
+void GuidingField::reset_counts() {
+  counts_ = std::make_unique<std::atomic<uint64_t>[]>(leaves_.size());
+  for (size_t i = 0; i < leaves_.size(); ++i) counts_[i].store(0, std::memory_order_relaxed);
 }
 
 uint32_t GuidingField::leaf_at(Vec3 p) const {
@@ -21,29 +29,63 @@ uint32_t GuidingField::leaf_at(Vec3 p) const {
   return nodes_[node].leaf;
 }
 
-void GuidingField::record(const RadianceRecord& r) { record(leaf_at(r.p), r.wi, r.value); }
+uint32_t GuidingField::jittered_leaf(Vec3 p, uint32_t leaf, Vec3 u) const {
+  const Vec3 size = leaves_[leaf].box.diagonal();
+  return leaf_at(p + (u - Vec3(0.5f, 0.5f, 0.5f)) * size);
+}
 
-void GuidingField::record(uint32_t leaf, Vec3 wi, float value) {
-  Leaf& l = leaves_[leaf];
-  ++l.samples;
-  if (value > 0 && std::isfinite(value)) l.recording.record(direction_to_square(wi), value);
+float GuidingField::bsdf_fraction(uint32_t leaf) const {
+  return settings_.bsdf_fraction >= 0 ? settings_.bsdf_fraction
+                                      : leaves_[leaf].selection.bsdf_fraction();
+}
+
+void GuidingField::record(const GuidingRecord& r) {
+  if (r.statistical_weight > 0) count_vertex(r.leaf);
+  record_into(leaves_[r.leaf], r);
+}
+
+void GuidingField::record_into(Leaf& leaf, const GuidingRecord& r) {
+  if (r.radiance > 0 && std::isfinite(r.radiance)) {
+    if (settings_.filter)
+      leaf.recording.record_filtered(r.square, r.radiance);
+    else
+      leaf.recording.record(r.square, r.radiance);
+  }
+  if (settings_.bsdf_fraction < 0 && r.guide_pdf > 0 && r.product > 0)
+    leaf.selection.add(r.product, r.bsdf_pdf, r.guide_pdf, r.statistical_weight);
+}
+
+void GuidingField::splat(std::vector<GuidingRecord>& records) {
+  // (leaf, key) is unique for the caller's keys, so any sort gives the same order.
+  tbb::parallel_sort(records.begin(), records.end(),
+                     [](const GuidingRecord& a, const GuidingRecord& b) {
+                       return a.leaf != b.leaf ? a.leaf < b.leaf : a.key < b.key;
+                     });
+  std::vector<size_t> starts;
+  for (size_t i = 0; i < records.size(); ++i)
+    if (i == 0 || records[i].leaf != records[i - 1].leaf) starts.push_back(i);
+  starts.push_back(records.size());
+  tbb::parallel_for(size_t(0), starts.size() - 1, [&](size_t g) {
+    Leaf& leaf = leaves_[records[starts[g]].leaf];
+    for (size_t i = starts[g]; i < starts[g + 1]; ++i) record_into(leaf, records[i]);
+  });
 }
 
 // Müller et al. 2017, sec. 3.4: "we subdivide a leaf node if it contains more than
 // c sqrt(2^k) path vertices"; the children inherit the directional distributions.
-void GuidingField::split(uint32_t node) {
-  const Bounds3 box = nodes_[node].box;
+void GuidingField::split(uint32_t node, std::vector<uint64_t>& counts) {
+  const uint32_t leaf = nodes_[node].leaf;
+  const Bounds3 box = leaves_[leaf].box;
   const Vec3 d = box.diagonal();
   const int axis = d.x >= d.y && d.x >= d.z ? 0 : (d.y >= d.z ? 1 : 2);
   const float middle = 0.5f * (box.lo[axis] + box.hi[axis]);
-  const uint32_t leaf = nodes_[node].leaf;
-  leaves_[leaf].samples /= 2;
+  counts[leaf] /= 2;
   const uint32_t copy = uint32_t(leaves_.size());
   leaves_.push_back(leaves_[leaf]);
+  counts.push_back(counts[leaf]);
+  leaves_[leaf].box.hi[axis] = middle;
+  leaves_[copy].box.lo[axis] = middle;
   SpatialNode lower, upper;
-  lower.box = upper.box = box;
-  lower.box.hi[axis] = middle;
-  upper.box.lo[axis] = middle;
   lower.leaf = leaf;
   upper.leaf = copy;
   const uint32_t first = uint32_t(nodes_.size());
@@ -56,33 +98,45 @@ void GuidingField::split(uint32_t node) {
   n.middle = middle;
 }
 
-void GuidingField::end_iteration(int k) {
-  for (Leaf& l : leaves_) {
-    l.recording.propagate();
-    l.sampling = std::move(l.recording);
-    l.recording = DirectionalQuadtree();
-  }
-  auto used = [&] {
-    size_t n = 0;
-    for (const Leaf& l : leaves_) n += l.sampling.node_count() + l.recording.node_count();
-    return n;
-  };
+size_t GuidingField::leaf_bytes(const Leaf& l) const {
+  return sizeof(Leaf) + 2 * sizeof(SpatialNode) + sizeof(uint64_t) + l.sampling.bytes() +
+         l.recording.bytes();
+}
+
+void GuidingField::split_leaves(int k) {
   const double threshold = settings_.spatial_threshold * std::sqrt(std::ldexp(1.0, k));
-  size_t nodes = used();
+  size_t bytes = memory_bytes();
+  std::vector<uint64_t> counts(leaves_.size());
+  for (size_t i = 0; i < leaves_.size(); ++i) counts[i] = counts_[i].load();
   // nodes_ grows inside the loop: new children are visited too, so a leaf splits repeatedly.
   for (uint32_t i = 0; i < nodes_.size(); ++i) {
     if (nodes_[i].child[0]) continue;
-    const Leaf& l = leaves_[nodes_[i].leaf];
-    const size_t cost = l.sampling.node_count() + l.recording.node_count();
-    if (double(l.samples) <= threshold || nodes + cost > settings_.max_quadtree_nodes) continue;
-    nodes += cost;
-    split(i);
+    const size_t cost = leaf_bytes(leaves_[nodes_[i].leaf]);
+    if (double(counts[nodes_[i].leaf]) <= threshold || bytes + cost > settings_.max_bytes) continue;
+    bytes += cost;
+    split(i, counts);
   }
-  size_t budget = settings_.max_quadtree_nodes > nodes ? settings_.max_quadtree_nodes - nodes : 0;
+  nodes_.shrink_to_fit();
+  leaves_.shrink_to_fit();
+}
+
+void GuidingField::end_pass(int k) {
+  for (Leaf& l : leaves_) {
+    l.recording.propagate();
+    l.sampling = std::move(l.recording);
+    l.sampling.shrink_to_fit();
+    l.recording = DirectionalQuadtree();
+  }
+  split_leaves(k);
+  const size_t bytes = memory_bytes();
+  size_t budget = settings_.max_bytes > bytes
+                      ? (settings_.max_bytes - bytes) / DirectionalQuadtree::kNodeBytes
+                      : 0;
   for (Leaf& l : leaves_) {
     l.recording = l.sampling.refined(settings_.rho, settings_.max_quadtree_depth, &budget);
-    l.samples = 0;
+    l.recording.shrink_to_fit();
   }
+  reset_counts();
 }
 
 size_t GuidingField::quadtree_node_count() const {
@@ -92,13 +146,15 @@ size_t GuidingField::quadtree_node_count() const {
 }
 
 size_t GuidingField::memory_bytes() const {
-  return quadtree_node_count() * DirectionalQuadtree::kNodeBytes +
-         nodes_.capacity() * sizeof(SpatialNode) + leaves_.capacity() * sizeof(Leaf);
+  size_t bytes = nodes_.capacity() * sizeof(SpatialNode) + leaves_.capacity() * sizeof(Leaf) +
+                 leaves_.size() * sizeof(std::atomic<uint64_t>);
+  for (const Leaf& l : leaves_) bytes += l.sampling.bytes() + l.recording.bytes();
+  return bytes;
 }
 
-uint64_t GuidingField::recorded_samples() const {
+uint64_t GuidingField::counted_vertices() const {
   uint64_t n = 0;
-  for (const Leaf& l : leaves_) n += l.samples;
+  for (size_t i = 0; i < leaves_.size(); ++i) n += counts_[i].load();
   return n;
 }
 

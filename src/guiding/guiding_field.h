@@ -1,48 +1,56 @@
 // The learned incident-radiance field of Müller et al. 2017, "Practical Path Guiding for
 // Efficient Light-Transport Simulation" (the SD-tree, sec. 3): a binary tree over the scene's
 // bounding box whose leaves each hold a directional quadtree (directional_quadtree.h) of the
-// radiance arriving in their region. Every leaf keeps two: `sampling`, learned in the previous
-// training iteration and read while rendering, and `recording`, which the current iteration's
+// radiance arriving in their region, and the learned BSDF-vs-guide selection probability of
+// Müller 2019 (selection_optimizer.h). Every leaf keeps two quadtrees: `sampling`, learned in the
+// previous training pass and read while rendering, and `recording`, which the current pass's
 // samples are splatted into.
 //
-// Training iteration k ends with end_iteration(k) (sec. 3.4):
+// Training pass k ends with end_pass(k) (sec. 3.4):
 //  1. recording becomes sampling;
-//  2. a leaf that recorded more than c sqrt(2^k) samples is split in two at the middle of its
-//     box's longest axis (the children copy its distributions and half its count), repeatedly;
+//  2. a leaf that recorded more than c sqrt(2^k) path vertices (statistical weight) is split in
+//     two at the middle of its box's longest axis (the children copy its distributions, its
+//     selection optimizer and half its weight), repeatedly;
 //  3. each leaf's recording structure is rebuilt from its sampling distribution, refining
 //     quadrants whose energy share exceeds rho (zero energies).
 //
-// Memory cap: the directional quadtrees of all leaves together hold at most
-// GuidingSettings::max_quadtree_nodes nodes (each DirectionalQuadtree::kNodeBytes bytes); where
-// a split or a refinement would exceed it, it is not done (leaves are visited in index order,
-// so what is kept is deterministic). memory_bytes() reports the whole structure.
+// Memory cap: the whole structure (memory_bytes(): spatial nodes, leaves and every quadtree)
+// stays under GuidingSettings::max_bytes. Splits and refinements that would exceed it are not
+// done (leaves are visited in index order, so what is kept is deterministic).
 //
-// Determinism: record() is sequential; callers splat their samples in a fixed order.
+// Determinism: splat() sorts the records by (leaf, key), where the caller's key orders them
+// independently of threads (pixel and position along the path), and then processes the leaves in
+// parallel, each leaf's records in that order: the field does not depend on thread scheduling.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/vec.h"
 #include "guiding/directional_quadtree.h"
+#include "guiding/guiding_settings.h"
+#include "guiding/selection_optimizer.h"
 
 namespace caustica {
 
-struct GuidingSettings {
-  double spatial_threshold = 12000;  // c of the split rule c sqrt(2^k) (Müller et al. 2017)
-  double rho = 0.01;                 // quadrant refinement threshold (energy share)
-  int max_quadtree_depth = 20;
-  size_t max_quadtree_nodes = size_t(1) << 21;  // the memory cap: about 100 MiB
-};
-
-// One radiance sample to splat: where, which direction (world, pointing away from p), and how
-// much: the incident radiance estimate divided by the density the direction was sampled with
-// (its luminance), so that sums over a quadrant estimate the flux through it.
-struct RadianceRecord {
-  Vec3 p;
-  Vec3 wi;
-  float value = 0;
+// One sample of the incident radiance at a point, to splat.
+struct GuidingRecord {
+  uint64_t key = 0;   // the caller's order (e.g. pixel, then vertex along the path)
+  uint32_t leaf = 0;  // the spatial leaf it goes to (after the spatial filter's jitter)
+  Vec2 square;        // its direction, on the unit square (direction_to_square)
+  // Luminance of the incident radiance estimate over the density its direction was sampled
+  // with (Müller et al. 2017, sec. 3.2: summed over a quadrant, an estimate of its flux).
+  float radiance = 0;
+  // Luminance of f |cos| L_i over the same density: the selection optimizer's target.
+  float product = 0;
+  // Densities (solid angle) of the BSDF and of the learned distribution at the direction;
+  // guide_pdf <= 0: the vertex had no learned distribution (the optimizer skips it).
+  float bsdf_pdf = 0, guide_pdf = 0;
+  // The selection optimizer's batch weight: 1 for a path vertex, 0 for a next event sample.
+  float statistical_weight = 1;
 };
 
 class GuidingField {
@@ -52,37 +60,57 @@ class GuidingField {
 
   // The leaf whose box holds p (points outside the box go to the nearest leaf).
   uint32_t leaf_at(Vec3 p) const;
+  // The leaf of p moved by (u - 1/2) times the size of the box of `leaf` (p's leaf): a sample of
+  // the box filter of the spatial splat (Müller 2019). u in [0, 1)^3.
+  uint32_t jittered_leaf(Vec3 p, uint32_t leaf, Vec3 u) const;
   // The distribution learned for the leaf; its total() is 0 until some radiance was recorded.
   const DirectionalQuadtree& sampling(uint32_t leaf) const { return leaves_[leaf].sampling; }
+  // The probability of sampling the BSDF at the leaf (fixed, or learned: guiding_settings.h).
+  float bsdf_fraction(uint32_t leaf) const;
 
-  void record(const RadianceRecord& r);
-  void record(uint32_t leaf, Vec3 wi, float value);
-  // Ends training iteration k (0-based, the k-th with 2^k samples per pixel); see above.
-  void end_iteration(int k);
+  // Counts a path vertex at a leaf for the split rule (from any thread: the count is an
+  // integer, so it does not depend on the order). Every guided vertex counts, whether or not it
+  // found radiance (Müller et al. 2017: "path vertices").
+  void count_vertex(uint32_t leaf) const { counts_[leaf].fetch_add(1, std::memory_order_relaxed); }
+  // Records one sample directly (sequential; tests), counting it as a vertex when its
+  // statistical weight is positive.
+  void record(const GuidingRecord& r);
+  // Sorts `records` and splats them (see Determinism above).
+  void splat(std::vector<GuidingRecord>& records);
+  // Ends training pass k (0-based, the k-th with 2^k samples per pixel); see above.
+  void end_pass(int k);
 
+  const GuidingSettings& settings() const { return settings_; }
   size_t leaf_count() const { return leaves_.size(); }
   size_t spatial_node_count() const { return nodes_.size(); }
   size_t quadtree_node_count() const;
   size_t memory_bytes() const;
-  uint64_t recorded_samples() const;  // in the current iteration
+  uint64_t counted_vertices() const;  // in the current pass
 
  private:
   struct SpatialNode {
-    Bounds3 box;
     uint32_t child[2] = {0, 0};  // both 0: a leaf
     uint32_t leaf = 0;           // index into leaves_ when a leaf
     int axis = 0;                // inner: the split axis, at `middle`
     float middle = 0;
   };
   struct Leaf {
+    Bounds3 box;
     DirectionalQuadtree sampling, recording;
-    uint64_t samples = 0;  // recorded in the current iteration
+    SelectionOptimizer selection;
   };
-  void split(uint32_t node);
+  void record_into(Leaf& leaf, const GuidingRecord& r);
+  void split(uint32_t node, std::vector<uint64_t>& counts);
+  void split_leaves(int k);
+  size_t leaf_bytes(const Leaf& l) const;
 
   GuidingSettings settings_;
+  Bounds3 bounds_;
   std::vector<SpatialNode> nodes_;  // nodes_[0] is the root
   std::vector<Leaf> leaves_;
+  // Path vertices per leaf in the current pass (count_vertex()).
+  mutable std::unique_ptr<std::atomic<uint64_t>[]> counts_;
+  void reset_counts();
 };
 
 }  // namespace caustica

@@ -4,6 +4,7 @@
 #include <bit>
 #include <nlohmann/json.hpp>
 
+#include "film/film.h"
 #include "integrators/path_vertex.h"
 #include "lights/light.h"
 #include "lights/light_sampler.h"
@@ -14,13 +15,129 @@ namespace caustica {
 
 namespace {
 
-// A scattering vertex whose incident radiance along wi is recorded once the path is done.
-struct GuidedVertex {
-  uint32_t leaf;
+// Records of one path are keyed pixel * kKeysPerPixel + their order along the path (at most two
+// per scattering vertex, and at most 255 vertices).
+constexpr uint64_t kKeysPerPixel = 512;
+
+// The one-sample MIS mixture at a vertex (Veach 1997, sec. 9.2.4): the BSDF with probability
+// bsdf_fraction, else the learned distribution; without one (guide == nullptr), the BSDF alone.
+struct Mixture {
+  const DirectionalQuadtree* guide = nullptr;
+  float bsdf_fraction = 1;
+  uint32_t record_leaf = 0;  // where this vertex's records go (the spatial filter's jitter)
+  bool guidable = false;     // records are learned here
+
+  float guide_pdf(Vec3 wi) const { return guide ? guide->pdf(wi) : 0.f; }
+  float pdf(float bsdf_pdf, float guide_pdf) const {
+    return guide ? bsdf_fraction * bsdf_pdf + (1 - bsdf_fraction) * guide_pdf : bsdf_pdf;
+  }
+};
+
+// A direction sampled from the mixture.
+struct MixtureSample {
   Vec3 wi;
-  float pdf;       // the density wi was sampled with (the mixture's where guided)
-  Rgb beta_after;  // path throughput including this vertex's f |cos| / pdf
-  Rgb incident;    // estimate of the radiance arriving along wi (Müller et al. 2017, sec. 4)
+  float pdf = 0;  // the mixture's (the BSDF's alone without a guide)
+  float bsdf_pdf = 0, guide_pdf = 0;
+  Rgb weight;  // f |cos| / pdf
+  bool specular = false;
+  float eta2 = 1;  // eta^2 of a sampled refraction (for Russian roulette)
+};
+
+std::optional<MixtureSample> sample_mixture(const Bsdf& bsdf, Vec3 wo, const Mixture& m,
+                                            float u_technique, float uc, Vec2 u) {
+  MixtureSample s;
+  if (m.guide && u_technique >= m.bsdf_fraction) {
+    s.wi = m.guide->sample(u);
+  } else {
+    const auto bs = bsdf.sample(wo, uc, u, TransportMode::Radiance);
+    if (!bs) return std::nullopt;
+    s.wi = bs->wi;
+    if (bs->is_transmission()) s.eta2 = sqr(bs->eta);
+    if (!m.guide) {
+      s.specular = bs->is_specular();
+      s.pdf = s.bsdf_pdf =
+          bs->pdf_is_proportional ? bsdf.pdf(wo, s.wi, TransportMode::Radiance) : bs->pdf;
+      s.weight = bs->f * (bsdf.abs_cos(s.wi) / bs->pdf);
+      return s;
+    }
+  }
+  s.bsdf_pdf = bsdf.pdf(wo, s.wi, TransportMode::Radiance);
+  s.guide_pdf = m.guide_pdf(s.wi);
+  s.pdf = m.pdf(s.bsdf_pdf, s.guide_pdf);
+  if (!(s.pdf > 0)) return std::nullopt;
+  s.weight = bsdf.f(wo, s.wi, TransportMode::Radiance) * (bsdf.abs_cos(s.wi) / s.pdf);
+  return s;
+}
+
+// A guided vertex whose incident radiance along wi is recorded once the path is done.
+struct GuidedVertex {
+  GuidingRecord record;  // radiance and product filled in at the end
+  float pdf;             // the density wi was sampled with
+  Rgb weight;            // f |cos| / pdf
+  Rgb beta_after;        // path throughput including this vertex's weight
+  Rgb incident;          // estimate of the radiance arriving along wi (Müller et al. 2017)
+};
+
+// What one path teaches the field: its guided vertices and their next event samples.
+class PathLearning {
+ public:
+  PathLearning(ScratchArena& arena, int max_vertices, uint64_t pixel,
+               std::vector<GuidingRecord>& records)
+      : vertices_(static_cast<GuidedVertex*>(arena.allocate(
+            sizeof(GuidedVertex) * size_t(std::max(max_vertices, 1)), alignof(GuidedVertex)))),
+        records_(records),
+        key_(pixel * kKeysPerPixel) {}
+
+  // A contribution c after vertex j is beta_after_j times an estimate of what arrives along its
+  // wi; every contribution reaches the vertices before it.
+  void contribute(Rgb c) {
+    for (int j = 0; j < count_; ++j)
+      for (int ch = 0; ch < 3; ++ch)
+        if (vertices_[j].beta_after[ch] > 0)
+          vertices_[j].incident[ch] += c[ch] / vertices_[j].beta_after[ch];
+  }
+  void add_vertex(const Mixture& m, const MixtureSample& s, Rgb beta_after) {
+    GuidingRecord r = base_record(m, s.wi, s.bsdf_pdf, s.guide_pdf);
+    vertices_[count_++] = {r, s.pdf, s.weight, beta_after, Rgb(0.f)};
+  }
+  // The next event sample's radiance times its MIS weight over the light density: the light
+  // technique's share of the incident radiance's flux estimate.
+  void add_next_event(const Mixture& m, const NextEventSeen& seen, float bsdf_pdf) {
+    if (seen.Li.is_black()) return;
+    const bool learn_selection = m.guide && !seen.delta_light;
+    GuidingRecord r = base_record(m, seen.wi, bsdf_pdf, learn_selection ? m.guide_pdf(seen.wi) : 0);
+    const float scale = seen.weight / seen.light_pdf;
+    r.radiance = seen.Li.luminance() * scale;
+    r.product = (seen.f * seen.Li).luminance() * scale;
+    r.statistical_weight = 0;
+    if (r.radiance > 0 && std::isfinite(r.radiance)) records_.push_back(r);
+  }
+  // Müller et al. 2017, sec. 3.2: each vertex splats L_i / pdf, an estimate of the flux
+  // through the quadrant it lands in.
+  void finish() {
+    for (int j = 0; j < count_; ++j) {
+      GuidedVertex& v = vertices_[j];
+      v.record.radiance = v.incident.luminance() / v.pdf;
+      v.record.product = (v.weight * v.incident).luminance();
+      if (v.record.radiance > 0 && std::isfinite(v.record.radiance)) records_.push_back(v.record);
+    }
+  }
+
+ private:
+  GuidingRecord base_record(const Mixture& m, Vec3 wi, float bsdf_pdf, float guide_pdf) {
+    GuidingRecord r;
+    r.key = key_++;
+    r.leaf = m.record_leaf;
+    r.square = direction_to_square(wi);
+    r.bsdf_pdf = bsdf_pdf;
+    r.guide_pdf = guide_pdf;
+    return r;
+  }
+
+  GuidedVertex* vertices_;
+  int count_ = 0;
+  std::vector<GuidingRecord>& records_;
+  uint64_t key_;
 };
 
 }  // namespace
@@ -37,36 +154,44 @@ float GuidedPathTracer::mis_weight(float pdf_a, float pdf_b) const {
 
 void GuidedPathTracer::prepare(const Scene& scene, Film& film) {
   CameraPathIntegrator::prepare(scene, film);
-  field_ = GuidingField(scene.bounds(), guiding_);
+  field_ = GuidingField(scene.bounds(), settings_.guiding);
+  passes_ = InverseVarianceCombiner(scene.camera().width(), scene.camera().height());
   pass_ = 0;
   recorded_ = 0;
+  peak_record_bytes_ = 0;
 }
 
 void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, Film& film) {
   const int pass = training_pass(iteration);
   if (pass > pass_) {
-    field_.end_iteration(pass_);
+    field_.end_pass(pass_);
+    passes_.end_pass();
     pass_ = pass;
   }
-  for (std::vector<Record>& r : records_) r.clear();
+  for (std::vector<GuidingRecord>& r : records_) r.clear();
   trace_camera_paths(scene, iteration, film);
+  passes_.end_iteration();
   merged_.clear();
-  for (const std::vector<Record>& r : records_) merged_.insert(merged_.end(), r.begin(), r.end());
-  // Threads' buffers come in any order; a pixel's records come from one path, in path order.
-  std::stable_sort(merged_.begin(), merged_.end(),
-                   [](const Record& a, const Record& b) { return a.pixel < b.pixel; });
-  for (const Record& r : merged_) field_.record(r.leaf, r.wi, r.value);
+  for (const std::vector<GuidingRecord>& r : records_)
+    merged_.insert(merged_.end(), r.begin(), r.end());
+  size_t bytes = merged_.capacity() * sizeof(GuidingRecord);
+  for (const std::vector<GuidingRecord>& r : records_)
+    bytes += r.capacity() * sizeof(GuidingRecord);
+  peak_record_bytes_ = std::max(peak_record_bytes_, bytes);
+  field_.splat(merged_);
   recorded_ += merged_.size();
+}
+
+Image GuidedPathTracer::image(const Film& film) const {
+  if (!settings_.guiding.inverse_variance) return film.image();
+  Image combined = passes_.image();
+  return combined.empty() ? film.image() : combined;
 }
 
 Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng,
                                ScratchArena& arena, uint64_t*) const {
   const LightSampler& lights = scene.light_sampler();
-  std::vector<Record>& records = records_.local();
-  auto* vertices = static_cast<GuidedVertex*>(arena.allocate(
-      sizeof(GuidedVertex) * size_t(std::max(settings_.max_depth, 1)), alignof(GuidedVertex)));
-  int vertex_count = 0;
-
+  PathLearning learning(arena, settings_.max_depth, sample.pixel, records_.local());
   Rgb L(0.f), beta(1.f);
   Ray ray = sample.ray;
   int depth = 0;
@@ -75,14 +200,9 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
   float prev_pdf = 0;   // density of the direction that produced `ray` (mixture where guided)
   Vec3 prev_p;
 
-  // Every contribution also reaches the earlier vertices' incident radiance: a contribution c
-  // after vertex j is beta_after_j times an estimate of what arrives along its wi.
   auto add = [&](Rgb c) {
     L += c;
-    for (int j = 0; j < vertex_count; ++j)
-      for (int ch = 0; ch < 3; ++ch)
-        if (vertices[j].beta_after[ch] > 0)
-          vertices[j].incident[ch] += c[ch] / vertices[j].beta_after[ch];
+    learning.contribute(c);
   };
   auto add_emission = [&](const SurfaceInteraction* hit) {
     for_each_emitter_seen(scene.infinite_lights(), ray, hit, [&](const Light& light, Rgb Le) {
@@ -100,65 +220,53 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     if (depth++ == settings_.max_depth) break;
 
     const Vec3 wo = si.wo;
-    const bool guidable = !is_specular(bsdf.flags()) && !bsdf.is_delta() && !bsdf.stochastic();
-    const uint32_t leaf = guidable ? field_.leaf_at(si.p) : 0;
-    const DirectionalQuadtree* guide =
-        guidable && field_.sampling(leaf).total() > 0 ? &field_.sampling(leaf) : nullptr;
-    // One-sample MIS (Veach 1997, sec. 9.2.4): the density of the mixture that picks the
-    // learned distribution with probability kGuidedFraction.
+    Mixture mix;
+    mix.guidable = !is_specular(bsdf.flags()) && !bsdf.is_delta() && !bsdf.stochastic();
+    if (mix.guidable) {
+      const uint32_t leaf = field_.leaf_at(si.p);
+      if (field_.sampling(leaf).total() > 0) {
+        mix.guide = &field_.sampling(leaf);
+        mix.bsdf_fraction = field_.bsdf_fraction(leaf);
+      }
+      mix.record_leaf =
+          settings_.guiding.filter
+              ? field_.jittered_leaf(si.p, leaf,
+                                     Vec3(rng.next_float(), rng.next_float(), rng.next_float()))
+              : leaf;
+    }
     auto mixture_pdf = [&](Vec3 wi) {
-      const float bsdf_pdf = bsdf.pdf(wo, wi, TransportMode::Radiance);
-      return guide ? (1 - kGuidedFraction) * bsdf_pdf + kGuidedFraction * guide->pdf(wi) : bsdf_pdf;
+      return mix.pdf(bsdf.pdf(wo, wi, TransportMode::Radiance), mix.guide_pdf(wi));
     };
 
     const float u_light = rng.next_float();
     const Vec2 u = rng.next_2d();
-    add(direct_light_mis(scene, si, bsdf, beta, u_light, u, mixture_pdf,
-                         [&](float a, float b) { return mis_weight(a, b); }));
+    NextEventSeen seen;
+    add(direct_light_mis(
+        scene, si, bsdf, beta, u_light, u, mixture_pdf,
+        [&](float a, float b) { return mis_weight(a, b); }, &seen));
+    if (mix.guidable && !seen.Li.is_black())
+      learning.add_next_event(mix, seen, bsdf.pdf(wo, seen.wi, TransportMode::Radiance));
 
     const float uc = rng.next_float();
     const Vec2 u_dir = rng.next_2d();
     const float u_technique = rng.next_float();
-    Vec3 wi;
-    float pdf;
-    Rgb weight;  // f |cos| / pdf
-    bool specular = false;
-    if (guide && u_technique < kGuidedFraction) {
-      wi = guide->sample(u_dir);
-      pdf = mixture_pdf(wi);
-      if (!(pdf > 0)) break;
-      weight = bsdf.f(wo, wi, TransportMode::Radiance) * (bsdf.abs_cos(wi) / pdf);
-    } else {
-      const auto bs = bsdf.sample(wo, uc, u_dir, TransportMode::Radiance);
-      if (!bs) break;
-      wi = bs->wi;
-      specular = bs->is_specular();
-      if (bs->is_transmission()) eta_scale *= sqr(bs->eta);
-      if (guide) {
-        pdf = mixture_pdf(wi);
-        weight = bsdf.f(wo, wi, TransportMode::Radiance) * (bsdf.abs_cos(wi) / pdf);
-      } else {
-        pdf = bs->pdf_is_proportional ? bsdf.pdf(wo, wi, TransportMode::Radiance) : bs->pdf;
-        weight = bs->f * (bsdf.abs_cos(wi) / bs->pdf);
-      }
+    const auto s = sample_mixture(bsdf, wo, mix, u_technique, uc, u_dir);
+    if (!s) break;
+    eta_scale *= s->eta2;
+    beta *= s->weight;
+    if (mix.guidable) {
+      field_.count_vertex(mix.record_leaf);
+      learning.add_vertex(mix, *s, beta);
     }
-    beta *= weight;
-    if (guidable) vertices[vertex_count++] = {leaf, wi, pdf, beta, Rgb(0.f)};
-    prev_pdf = pdf;
-    specular_bounce = specular;
+    prev_pdf = s->pdf;
+    specular_bounce = s->specular;
     prev_p = si.p;
-    ray = si.spawn_ray(wi);
+    ray = si.spawn_ray(s->wi);
     if (beta.is_black()) break;
     if (!survives_russian_roulette(beta, eta_scale, depth, rng)) break;
   }
-
-  // Müller et al. 2017, sec. 3.2: each vertex splats L_i / pdf, an estimate of the flux through
-  // the quadrant it lands in.
-  for (int j = 0; j < vertex_count; ++j) {
-    const GuidedVertex& v = vertices[j];
-    const float value = v.pdf > 0 ? v.incident.luminance() / v.pdf : 0.f;
-    records.push_back({sample.pixel, v.leaf, v.wi, std::isfinite(value) ? value : 0.f});
-  }
+  learning.finish();
+  passes_.add(sample.pixel, L * sample.filter_weight);
   return L;
 }
 
@@ -168,9 +276,15 @@ void GuidedPathTracer::report(nlohmann::json& stats) const {
   g["spatial_leaves"] = field_.leaf_count();
   g["spatial_nodes"] = field_.spatial_node_count();
   g["quadtree_nodes"] = field_.quadtree_node_count();
-  g["max_quadtree_nodes"] = guiding_.max_quadtree_nodes;
   g["guiding_bytes"] = field_.memory_bytes();
+  g["guiding_max_bytes"] = settings_.guiding.max_bytes;
+  g["record_buffer_peak_bytes"] = peak_record_bytes_;
+  g["pass_image_bytes"] = passes_.bytes();
   g["radiance_samples_recorded"] = recorded_;
+  nlohmann::json passes = nlohmann::json::array();
+  for (const InverseVarianceCombiner::Pass& p : passes_.passes())
+    passes.push_back({{"spp", p.samples}, {"variance", p.variance}});
+  g["passes"] = passes;
   stats["guiding"] = g;
 }
 

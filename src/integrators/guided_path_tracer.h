@@ -1,9 +1,25 @@
 // `guided-pt`: path tracing whose directions come from a one-sample MIS mixture of BSDF sampling
 // and the incident radiance learned while rendering (Müller et al. 2017, "Practical Path
-// Guiding for Efficient Light-Transport Simulation"; the field is guiding/guiding_field.h).
-// Next event estimation is kept, and light samples and emitter hits are combined by MIS with the
-// mixture's density. A camera-path integrator: the seam (camera_path.h) owns pixels, streams and
-// the film; path_vertex.h gives light samples, emitter pdfs and Russian roulette.
+// Guiding for Efficient Light-Transport Simulation", with the improvements of Müller 2019,
+// "Practical Path Guiding in Production"; the field is guiding/guiding_field.h). Next event
+// estimation is kept; light samples and emitter hits are combined by MIS with the mixture's
+// density. A camera-path integrator: the seam (camera_path.h) owns pixels, streams and the film;
+// path_vertex.h gives light samples, emitter pdfs and Russian roulette.
+//
+// The mixture at a vertex of spatial leaf l: p(w) = a p_bsdf(w) + (1 - a) p_guide(w), with a the
+// leaf's BSDF selection probability, learned by Adam (selection_optimizer.h) unless
+// --guiding-bsdf-fraction fixes it. Its density is used for the sampled direction's weight, the
+// emitter-hit MIS and the next-event MIS alike. Guided only where the BSDF has no delta lobe
+// (flags without Specular: a microfacet lobe that pbrt-v4 calls effectively smooth is Specular
+// here too) and is not stochastic (the layered BSDF); elsewhere the BSDF alone is sampled, as
+// `pt`, and nothing is recorded.
+//
+// What is learned: at every guided vertex, the radiance arriving along the sampled direction
+// (every later contribution divided by the throughput up to and including the vertex, emitter
+// hits with their MIS weight) over its density, and the next event sample's radiance times its
+// MIS weight over the light density, along the light's direction: together an MIS estimate of
+// the incident radiance's integral over each quadrant. Vertices whose estimate is zero are not
+// recorded (as Müller's implementation). Filtered splatting: guiding_settings.h.
 //
 // Training schedule: iteration i (one sample per pixel) belongs to pass p = floor(log2(i + 1)),
 // so pass p covers iterations [2^p - 1, 2^(p+1) - 1): 1, 2, 4, 8, ... samples per pixel, as the
@@ -11,17 +27,16 @@
 // passes before it and records into the next one; the first pass samples the BSDF alone.
 // Learning never stops, so --spp and --time budget training and rendering together.
 //
-// How training enters the image: every iteration counts with equal weight. Each iteration's
-// estimate is unbiased given the distribution it sampled with (learned from earlier iterations
-// only), so the average is unbiased throughout; early passes only add their (larger) variance.
+// How training enters the image: every pass is an unbiased estimate of the image (it samples
+// with a distribution learned from earlier passes only). The image combines the passes
+// weighted by the inverse of their variance (image/inverse_variance.h, Müller 2019): the early,
+// noisy passes count little, and no sample is thrown away. A pass with one sample per pixel has
+// no variance estimate and weight 0 (with two iterations or fewer, the plain average is shown).
+// With --guiding-combine equal every iteration counts the same (unbiased; the film's average).
 //
-// Guided only where the BSDF has no delta lobe (flags without Specular: a microfacet lobe that
-// pbrt-v4 calls effectively smooth is Specular here too) and is not stochastic (the layered
-// BSDF); elsewhere the BSDF alone is sampled, as `pt`.
-//
-// Determinism: the radiance samples of an iteration are collected per thread, sorted by pixel
-// (stably: a pixel's path runs on one thread, in order) and splatted after the iteration, so
-// the field and the image do not depend on thread scheduling.
+// Determinism: records carry the key (pixel, position along the path); the field sorts them
+// and splats each spatial leaf's records in that order after the iteration, so the field and
+// the image do not depend on thread scheduling.
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
@@ -29,22 +44,20 @@
 #include <vector>
 
 #include "guiding/guiding_field.h"
+#include "image/inverse_variance.h"
 #include "integrators/camera_path.h"
 
 namespace caustica {
 
 class GuidedPathTracer final : public CameraPathIntegrator {
  public:
-  // Probability of sampling the learned distribution where there is one (Müller et al. 2017
-  // use 0.5 as well).
-  static constexpr float kGuidedFraction = 0.5f;
-
-  explicit GuidedPathTracer(const IntegratorSettings& settings, const GuidingSettings& guiding = {})
-      : CameraPathIntegrator(settings.seed), settings_(settings), guiding_(guiding) {}
+  explicit GuidedPathTracer(const IntegratorSettings& settings)
+      : CameraPathIntegrator(settings.seed), settings_(settings) {}
   const char* name() const override { return "guided-pt"; }
 
   void prepare(const Scene& scene, Film& film) override;
   void render_iteration(const Scene& scene, uint32_t iteration, Film& film) override;
+  Image image(const Film& film) const override;
   void report(nlohmann::json& stats) const override;
 
   // The training pass of an iteration: floor(log2(iteration + 1)).
@@ -56,21 +69,17 @@ class GuidedPathTracer final : public CameraPathIntegrator {
                uint64_t* nonfinite) const override;
 
  private:
-  struct Record {
-    uint64_t pixel;
-    uint32_t leaf;
-    Vec3 wi;
-    float value;
-  };
   float mis_weight(float pdf_a, float pdf_b) const;
 
   IntegratorSettings settings_;
-  GuidingSettings guiding_;
   GuidingField field_;
   int pass_ = 0;
   uint64_t recorded_ = 0;
-  mutable tbb::enumerable_thread_specific<std::vector<Record>> records_;
-  std::vector<Record> merged_;
+  size_t peak_record_bytes_ = 0;
+  mutable tbb::enumerable_thread_specific<std::vector<GuidingRecord>> records_;
+  std::vector<GuidingRecord> merged_;
+  // Written by estimate(): one writer per pixel at a time.
+  mutable InverseVarianceCombiner passes_;
 };
 
 }  // namespace caustica

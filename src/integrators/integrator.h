@@ -9,6 +9,9 @@
 #include <optional>
 #include <string>
 
+#include "guiding/guiding_settings.h"
+#include "image/image.h"
+
 namespace caustica {
 
 class Scene;
@@ -33,6 +36,7 @@ struct IntegratorSettings {
   std::optional<MisHeuristic> mis;
   MisHeuristic mis_or(MisHeuristic fallback) const { return mis.value_or(fallback); }
   BidirSettings bidir;
+  GuidingSettings guiding;  // guided-pt (--guiding-*)
 };
 
 class Integrator {
@@ -51,6 +55,10 @@ class Integrator {
     (void)scene;
     (void)film;
   }
+  // The image of the iterations completed in film: by default their plain average
+  // (film.image()). An integrator that weights its iterations unequally (guided-pt: inverse
+  // variance) returns its own combination; the render loop and the comparisons use this.
+  virtual Image image(const Film& film) const;
   // Integrator-specific statistics for the JSON output.
   virtual void report(nlohmann::json& stats) const { (void)stats; }
 };

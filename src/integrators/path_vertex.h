@@ -79,19 +79,33 @@ bool next_scattering_vertex(const Scene& scene, Ray& ray, ScratchArena& arena,
   }
 }
 
+// What an unoccluded next event sample saw, for integrators that learn from it (path guiding):
+// the direction, the radiance arriving along it, f |cos| toward it, the density of the light
+// sample (for a delta light its selection probability) and the MIS weight.
+struct NextEventSeen {
+  Vec3 wi;
+  Rgb Li, f;
+  float light_pdf = 0, weight = 0;
+  bool delta_light = false;
+};
+
 // Next event estimation with MIS against BSDF-side sampling, as unidirectional camera paths do
 // it: beta * f * Le * w / p_light for an unoccluded light sample, else black (also for delta
 // BSDFs and light-less scenes). sampling_pdf(wi) is the solid-angle density with which the
 // path's own direction sampling would pick wi; mis(p_light, p_sampling) the heuristic; delta
-// lights get weight 1.
+// lights get weight 1. With `seen`, an unoccluded sample is also described there (else
+// seen->Li is black).
 template <typename SamplingPdf, typename Mis>
 Rgb direct_light_mis(const Scene& scene, const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
-                     float u_light, Vec2 u, SamplingPdf&& sampling_pdf, Mis&& mis) {
+                     float u_light, Vec2 u, SamplingPdf&& sampling_pdf, Mis&& mis,
+                     NextEventSeen* seen = nullptr) {
+  if (seen) seen->Li = Rgb(0.f);
   if (bsdf.is_delta() || scene.light_sampler().empty()) return Rgb(0.f);
   const auto d = sample_direct_light(scene, si, bsdf, u_light, u);
   if (!d || scene.occluded(d->shadow)) return Rgb(0.f);
   const float light_pdf = d->pmf * d->ls.pdf_w;
   const float w = d->light->is_delta() ? 1.f : mis(light_pdf, sampling_pdf(d->ls.wi));
+  if (seen) *seen = {d->ls.wi, d->ls.radiance, d->f, light_pdf, w, d->light->is_delta()};
   return beta * d->f * d->ls.radiance * (w / light_pdf);
 }
 

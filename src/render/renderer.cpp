@@ -122,7 +122,7 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
   r.rays = totals.rays;
   r.interrupted = totals.interrupted > 0;
   if (rank_count == 1) {
-    r.image = film.image();
+    r.image = integrator.image(film);
     r.nonfinite = film.nonfinite_count();
   } else {
     Film sum(film.width(), film.height());

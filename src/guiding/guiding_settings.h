@@ -1,0 +1,33 @@
+// The knobs of path guiding (Müller et al. 2017, "Practical Path Guiding for Efficient
+// Light-Transport Simulation", with the improvements of Müller 2019, "Practical Path Guiding in
+// Production", SIGGRAPH course "Path Guiding in Production"). The command line sets them with
+// the --guiding-* options; the defaults are the papers'.
+#pragma once
+
+#include <cstddef>
+
+namespace caustica {
+
+struct GuidingSettings {
+  // c of the spatial split rule: a leaf that recorded more than c sqrt(2^k) path vertices in
+  // training pass k (2^k samples per pixel) is split (Müller et al. 2017, sec. 3.4).
+  double spatial_threshold = 12000;
+  // A directional quadrant is refined where its share of the leaf's energy exceeds rho.
+  double rho = 0.01;
+  int max_quadtree_depth = 20;
+  // The memory cap: the whole structure (spatial tree, leaves, directional quadtrees) stays
+  // under this many bytes; splits and refinements that would exceed it are not done.
+  size_t max_bytes = size_t(32) << 20;
+  // Filtered splatting (Müller 2019): each record is spread over a box the size of its spatial
+  // leaf (stochastically: a jittered position) and of its directional leaf (deterministically:
+  // by overlap area).
+  bool filter = true;
+  // The probability of sampling the BSDF rather than the learned distribution: learned per
+  // spatial leaf by Adam on the KL divergence gradient (Müller 2019) when negative, else fixed.
+  float bsdf_fraction = -1;
+  // Rendering passes enter the image weighted by their inverse variance (Müller 2019); false:
+  // every iteration with equal weight.
+  bool inverse_variance = true;
+};
+
+}  // namespace caustica

@@ -10,6 +10,7 @@
 #include "chi2.h"
 #include "core/math.h"
 #include "guiding/guiding_field.h"
+#include "image/inverse_variance.h"
 #include "integrators/guided_path_tracer.h"
 #include "io/builtin_scenes.h"
 #include "test_scenes.h"
@@ -160,6 +161,127 @@ TEST(Guiding, MemoryCapBoundsTheStructure) {
   EXPECT_LE(field.memory_bytes(), s.max_bytes);
   EXPECT_GT(field.memory_bytes(), s.max_bytes / 2) << "the cap was reached";
   EXPECT_GE(field.memory_bytes(), field.quadtree_node_count() * DirectionalQuadtree::kNodeBytes);
+}
+
+// Filtered splatting spreads a record over neighbouring quadrants without losing or creating
+// energy, also where the box crosses phi = 0 (it wraps) or the poles (it is moved inside).
+TEST(Guiding, FilteredSplatConservesEnergy) {
+  GuidingField field = trained_cone(kCone, 3);
+  size_t budget = 1000;
+  DirectionalQuadtree d = field.sampling(0).refined(0.01, 20, &budget);
+  const Vec2 points[] = {
+      {0.5f, 0.5f}, {0.3f, 0.001f}, {0.3f, 0.999f}, {0.0001f, 0.5f}, {0.9999f, 0.9999f}};
+  double expected = 0;
+  for (Vec2 p : points) {
+    d.record_filtered(p, 2.5);
+    expected += 2.5;
+  }
+  d.propagate();
+  EXPECT_NEAR(d.total(), expected, 1e-9 * expected);
+  // A point in the middle of a leaf of an unrefined tree (leaf side 1/2) stays in that leaf.
+  DirectionalQuadtree flat;
+  flat.record_filtered({0.25f, 0.25f}, 1.0);
+  flat.propagate();
+  EXPECT_NEAR(flat.pdf_square({0.25f, 0.25f}), 4.0, 1e-6);
+}
+
+// Splatting the same records in any order (as threads would produce them) gives the same field,
+// bit for bit: the field sorts them by (leaf, key).
+TEST(Guiding, SplatIsIndependentOfRecordOrder) {
+  auto make_records = [] {
+    std::vector<GuidingRecord> records;
+    Pcg32 rng(5, 6);
+    for (uint64_t i = 0; i < 20000; ++i) {
+      GuidingRecord r;
+      r.key = i;
+      r.leaf = 0;
+      r.square = rng.next_2d();
+      r.radiance = rng.next_float() * 10;
+      r.product = r.radiance * 0.3f;
+      r.bsdf_pdf = rng.next_float();
+      r.guide_pdf = rng.next_float();
+      records.push_back(r);
+    }
+    return records;
+  };
+  auto train_with = [&](bool shuffled) {
+    GuidingField field = trained_cone(kCone, 2);
+    std::vector<GuidingRecord> records = make_records();
+    if (shuffled) std::reverse(records.begin(), records.end());
+    field.splat(records);
+    field.end_pass(2);
+    return field;
+  };
+  const GuidingField a = train_with(false), b = train_with(true);
+  const DirectionalQuadtree &da = a.sampling(0), &db = b.sampling(0);
+  EXPECT_EQ(da.total(), db.total());
+  EXPECT_EQ(a.bsdf_fraction(0), b.bsdf_fraction(0));
+  Pcg32 rng(1, 1);
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 w = square_to_direction(rng.next_2d());
+    ASSERT_EQ(da.pdf(w), db.pdf(w));
+  }
+}
+
+// The learned selection probability moves toward the technique whose density matches the
+// product f |cos| L_i: toward the BSDF when the product follows it, toward the guide when the
+// product follows the guide (samples drawn from the current mixture, as the integrator does).
+TEST(Guiding, SelectionProbabilityFollowsTheBetterTechnique) {
+  // Densities on [0, 1]: the BSDF is uniform, the guide is 1.9 on [0, 1/2) and 0.1 elsewhere.
+  auto guide_pdf = [](float x) { return x < 0.5f ? 1.9f : 0.1f; };
+  auto learn = [&](auto product) {
+    SelectionOptimizer opt;
+    Pcg32 rng(3, 4);
+    for (int i = 0; i < 20000; ++i) {
+      const float a = opt.bsdf_fraction();
+      const float x = rng.next_float() < a
+                          ? rng.next_float()
+                          : (rng.next_float() < 0.95f ? 0.5f * rng.next_float()
+                                                      : 0.5f + 0.5f * rng.next_float());
+      const float pdf = a * 1.f + (1 - a) * guide_pdf(x);
+      opt.add(product(x) / pdf, 1.f, guide_pdf(x), 1.f);
+    }
+    return opt.bsdf_fraction();
+  };
+  const float follows_guide = learn([&](float x) { return guide_pdf(x); });
+  const float follows_bsdf = learn([](float) { return 1.f; });
+  std::printf("[ guiding ] learned BSDF fraction: %.3f (product = guide), %.3f (product = BSDF)\n",
+              follows_guide, follows_bsdf);
+  EXPECT_LT(follows_guide, 0.2f);
+  EXPECT_GT(follows_bsdf, 0.8f);
+}
+
+// Passes combine by inverse variance: a pass with four times the variance gets a quarter of the
+// weight; a pass of one sample per pixel has no estimate and no weight.
+TEST(Guiding, InverseVarianceCombinationWeightsPasses) {
+  InverseVarianceCombiner c(1, 2);
+  c.add(0, Rgb(100.f));  // one sample per pixel: ignored
+  c.add(1, Rgb(100.f));
+  c.end_iteration();
+  EXPECT_TRUE(c.image().empty()) << "no variance estimate yet";
+  c.end_pass();
+  // Pass 1: samples 0 and 2 (mean 1, variance of the mean 1); pass 2: 0 and 4 (mean 2, 4).
+  for (float v : {0.f, 2.f}) {
+    c.add(0, Rgb(v));
+    c.add(1, Rgb(v));
+    c.end_iteration();
+  }
+  c.end_pass();
+  for (float v : {0.f, 4.f}) {
+    c.add(0, Rgb(v));
+    c.add(1, Rgb(v));
+    c.end_iteration();
+  }
+  const Image image = c.image();
+  ASSERT_FALSE(image.empty());
+  // (1 / 1 + 2 / 4) / (1 / 1 + 1 / 4) = 1.2
+  EXPECT_NEAR(image[0].r, 1.2f, 1e-5f);
+  EXPECT_NEAR(image[1].g, 1.2f, 1e-5f);
+  const auto passes = c.passes();
+  ASSERT_EQ(passes.size(), 3u);
+  EXPECT_LT(passes[0].variance, 0);
+  EXPECT_NEAR(passes[1].variance, 1.0, 1e-9);
+  EXPECT_NEAR(passes[2].variance, 4.0, 1e-9);
 }
 
 TEST(GuidedPathTracer, TrainingPassesDoubleInLength) {

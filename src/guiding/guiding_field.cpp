@@ -9,7 +9,7 @@ namespace caustica {
 
 GuidingField::GuidingField(Bounds3 bounds, const GuidingSettings& settings)
     : settings_(settings), bounds_(bounds.empty() ? Bounds3{{0, 0, 0}, {1, 1, 1}} : bounds) {
-  nodes_.emplace_back();
+  nodes_.emplace_back();  // a leaf: leaves_[0]
   leaves_.emplace_back();
   leaves_[0].box = bounds_;
   reset_counts();
@@ -21,12 +21,9 @@ void GuidingField::reset_counts() {
 }
 
 uint32_t GuidingField::leaf_at(Vec3 p) const {
-  uint32_t node = 0;
-  while (nodes_[node].child[0]) {
-    const SpatialNode& n = nodes_[node];
-    node = n.child[p[n.axis] >= n.middle];
-  }
-  return nodes_[node].leaf;
+  SpatialNode n = nodes_[0];
+  while (n.axis() != SpatialNode::kLeaf) n = nodes_[n.index() + (p[int(n.axis())] >= n.middle)];
+  return n.index();
 }
 
 uint32_t GuidingField::jittered_leaf(Vec3 p, uint32_t leaf, Vec3 u) const {
@@ -74,28 +71,25 @@ void GuidingField::splat(std::vector<GuidingRecord>& records) {
 // Müller et al. 2017, sec. 3.4: "we subdivide a leaf node if it contains more than
 // c sqrt(2^k) path vertices"; the children inherit the directional distributions.
 void GuidingField::split(uint32_t node, std::vector<uint64_t>& counts) {
-  const uint32_t leaf = nodes_[node].leaf;
+  const uint32_t leaf = nodes_[node].index();
   const Bounds3 box = leaves_[leaf].box;
   const Vec3 d = box.diagonal();
-  const int axis = d.x >= d.y && d.x >= d.z ? 0 : (d.y >= d.z ? 1 : 2);
-  const float middle = 0.5f * (box.lo[axis] + box.hi[axis]);
+  const uint32_t axis = d.x >= d.y && d.x >= d.z ? 0 : (d.y >= d.z ? 1 : 2);
+  const float middle = 0.5f * (box.lo[int(axis)] + box.hi[int(axis)]);
   counts[leaf] /= 2;
   const uint32_t copy = uint32_t(leaves_.size());
   leaves_.push_back(leaves_[leaf]);
   counts.push_back(counts[leaf]);
-  leaves_[leaf].box.hi[axis] = middle;
-  leaves_[copy].box.lo[axis] = middle;
+  leaves_[leaf].box.hi[int(axis)] = middle;
+  leaves_[copy].box.lo[int(axis)] = middle;
   SpatialNode lower, upper;
-  lower.leaf = leaf;
-  upper.leaf = copy;
+  lower.packed = (SpatialNode::kLeaf << 30) | leaf;
+  upper.packed = (SpatialNode::kLeaf << 30) | copy;
   const uint32_t first = uint32_t(nodes_.size());
   nodes_.push_back(lower);
   nodes_.push_back(upper);
-  SpatialNode& n = nodes_[node];
-  n.child[0] = first;
-  n.child[1] = first + 1;
-  n.axis = axis;
-  n.middle = middle;
+  nodes_[node].packed = (axis << 30) | first;
+  nodes_[node].middle = middle;
 }
 
 size_t GuidingField::leaf_bytes(const Leaf& l) const {
@@ -110,9 +104,10 @@ void GuidingField::split_leaves(int k) {
   for (size_t i = 0; i < leaves_.size(); ++i) counts[i] = counts_[i].load();
   // nodes_ grows inside the loop: new children are visited too, so a leaf splits repeatedly.
   for (uint32_t i = 0; i < nodes_.size(); ++i) {
-    if (nodes_[i].child[0]) continue;
-    const size_t cost = leaf_bytes(leaves_[nodes_[i].leaf]);
-    if (double(counts[nodes_[i].leaf]) <= threshold || bytes + cost > settings_.max_bytes) continue;
+    if (nodes_[i].axis() != SpatialNode::kLeaf) continue;
+    const uint32_t leaf = nodes_[i].index();
+    const size_t cost = leaf_bytes(leaves_[leaf]);
+    if (double(counts[leaf]) <= threshold || bytes + cost > settings_.max_bytes) continue;
     bytes += cost;
     split(i, counts);
   }

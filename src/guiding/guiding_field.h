@@ -88,11 +88,14 @@ class GuidingField {
   uint64_t counted_vertices() const;  // in the current pass
 
  private:
+  // 8 bytes, so that the descent stays in cache: the two children of an inner node are
+  // adjacent, and a leaf stores its index into leaves_.
   struct SpatialNode {
-    uint32_t child[2] = {0, 0};  // both 0: a leaf
-    uint32_t leaf = 0;           // index into leaves_ when a leaf
-    int axis = 0;                // inner: the split axis, at `middle`
-    float middle = 0;
+    static constexpr uint32_t kLeaf = 3, kIndexMask = (1u << 30) - 1;
+    float middle = 0;               // inner: the split position along the axis
+    uint32_t packed = kLeaf << 30;  // bits 30-31: axis (kLeaf: a leaf); 0-29: first child / leaf
+    uint32_t axis() const { return packed >> 30; }
+    uint32_t index() const { return packed & kIndexMask; }
   };
   struct Leaf {
     Bounds3 box;

@@ -4,6 +4,7 @@
 #include <bit>
 #include <nlohmann/json.hpp>
 
+#include "core/math.h"
 #include "film/film.h"
 #include "integrators/path_vertex.h"
 #include "lights/light.h"
@@ -19,6 +20,13 @@ namespace {
 // per scattering vertex, and at most 255 vertices).
 constexpr uint64_t kKeysPerPixel = 512;
 
+// The densities of one direction, evaluated once: where it lies on the guide's square, the
+// BSDF's density and the learned one (0 without a guide).
+struct DirectionPdfs {
+  Vec2 square;
+  float bsdf = 0, guide = 0;
+};
+
 // The one-sample MIS mixture at a vertex (Veach 1997, sec. 9.2.4): the BSDF with probability
 // bsdf_fraction, else the learned distribution; without one (guide == nullptr), the BSDF alone.
 struct Mixture {
@@ -27,18 +35,26 @@ struct Mixture {
   uint32_t record_leaf = 0;  // where this vertex's records go (the spatial filter's jitter)
   bool guidable = false;     // records are learned here
 
-  float guide_pdf(Vec3 wi) const { return guide ? guide->pdf(wi) : 0.f; }
-  float pdf(float bsdf_pdf, float guide_pdf) const {
-    return guide ? bsdf_fraction * bsdf_pdf + (1 - bsdf_fraction) * guide_pdf : bsdf_pdf;
+  DirectionPdfs evaluate(const Bsdf& bsdf, Vec3 wo, Vec3 wi) const {
+    DirectionPdfs d;
+    d.square = direction_to_square(wi);
+    d.bsdf = bsdf.pdf(wo, wi, TransportMode::Radiance);
+    if (guide) d.guide = guide->pdf_square(d.square) * kInv4Pi;
+    return d;
+  }
+  float pdf(const DirectionPdfs& d) const {
+    return guide ? bsdf_fraction * d.bsdf + (1 - bsdf_fraction) * d.guide : d.bsdf;
   }
 };
 
 // A direction sampled from the mixture.
 struct MixtureSample {
   Vec3 wi;
-  float pdf = 0;  // the mixture's (the BSDF's alone without a guide)
-  float bsdf_pdf = 0, guide_pdf = 0;
-  Rgb weight;  // f |cos| / pdf
+  float pdf = 0;       // the mixture's (the BSDF's alone without a guide)
+  DirectionPdfs pdfs;  // filled where the vertex is guidable
+  Rgb weight;          // f |cos| / pdf
+  // f |cos| / p_bsdf: what the weight would be had the BSDF alone been sampled (Russian roulette)
+  Rgb bsdf_weight;
   bool specular = false;
   float eta2 = 1;  // eta^2 of a sampled refraction (for Russian roulette)
 };
@@ -55,17 +71,18 @@ std::optional<MixtureSample> sample_mixture(const Bsdf& bsdf, Vec3 wo, const Mix
     if (bs->is_transmission()) s.eta2 = sqr(bs->eta);
     if (!m.guide) {
       s.specular = bs->is_specular();
-      s.pdf = s.bsdf_pdf =
-          bs->pdf_is_proportional ? bsdf.pdf(wo, s.wi, TransportMode::Radiance) : bs->pdf;
-      s.weight = bs->f * (bsdf.abs_cos(s.wi) / bs->pdf);
+      s.pdf = bs->pdf_is_proportional ? bsdf.pdf(wo, s.wi, TransportMode::Radiance) : bs->pdf;
+      s.weight = s.bsdf_weight = bs->f * (bsdf.abs_cos(s.wi) / bs->pdf);
+      if (m.guidable) s.pdfs = {direction_to_square(s.wi), s.pdf, 0.f};
       return s;
     }
   }
-  s.bsdf_pdf = bsdf.pdf(wo, s.wi, TransportMode::Radiance);
-  s.guide_pdf = m.guide_pdf(s.wi);
-  s.pdf = m.pdf(s.bsdf_pdf, s.guide_pdf);
+  s.pdfs = m.evaluate(bsdf, wo, s.wi);
+  s.pdf = m.pdf(s.pdfs);
   if (!(s.pdf > 0)) return std::nullopt;
-  s.weight = bsdf.f(wo, s.wi, TransportMode::Radiance) * (bsdf.abs_cos(s.wi) / s.pdf);
+  const Rgb f_cos = bsdf.f(wo, s.wi, TransportMode::Radiance) * bsdf.abs_cos(s.wi);
+  s.weight = f_cos / s.pdf;
+  s.bsdf_weight = s.pdfs.bsdf > 0 ? f_cos / s.pdfs.bsdf : Rgb(0.f);
   return s;
 }
 
@@ -97,15 +114,14 @@ class PathLearning {
           vertices_[j].incident[ch] += c[ch] / vertices_[j].beta_after[ch];
   }
   void add_vertex(const Mixture& m, const MixtureSample& s, Rgb beta_after) {
-    GuidingRecord r = base_record(m, s.wi, s.bsdf_pdf, s.guide_pdf);
+    GuidingRecord r = base_record(m, s.pdfs);
     vertices_[count_++] = {r, s.pdf, s.weight, beta_after, Rgb(0.f)};
   }
   // The next event sample's radiance times its MIS weight over the light density: the light
   // technique's share of the incident radiance's flux estimate.
-  void add_next_event(const Mixture& m, const NextEventSeen& seen, float bsdf_pdf) {
-    if (seen.Li.is_black()) return;
-    const bool learn_selection = m.guide && !seen.delta_light;
-    GuidingRecord r = base_record(m, seen.wi, bsdf_pdf, learn_selection ? m.guide_pdf(seen.wi) : 0);
+  void add_next_event(const Mixture& m, const NextEventSeen& seen, const DirectionPdfs& pdfs) {
+    GuidingRecord r = base_record(m, pdfs);
+    if (seen.delta_light) r.guide_pdf = 0;  // not a solid-angle sample: no selection gradient
     const float scale = seen.weight / seen.light_pdf;
     r.radiance = seen.Li.luminance() * scale;
     r.product = (seen.f * seen.Li).luminance() * scale;
@@ -124,13 +140,13 @@ class PathLearning {
   }
 
  private:
-  GuidingRecord base_record(const Mixture& m, Vec3 wi, float bsdf_pdf, float guide_pdf) {
+  GuidingRecord base_record(const Mixture& m, const DirectionPdfs& pdfs) {
     GuidingRecord r;
     r.key = key_++;
     r.leaf = m.record_leaf;
-    r.square = direction_to_square(wi);
-    r.bsdf_pdf = bsdf_pdf;
-    r.guide_pdf = guide_pdf;
+    r.square = pdfs.square;
+    r.bsdf_pdf = pdfs.bsdf;
+    r.guide_pdf = pdfs.guide;
     return r;
   }
 
@@ -193,6 +209,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
   const LightSampler& lights = scene.light_sampler();
   PathLearning learning(arena, settings_.max_depth, sample.pixel, records_.local());
   Rgb L(0.f), beta(1.f);
+  Rgb rr_beta(1.f);  // the throughput of BSDF sampling, for Russian roulette
   Ray ray = sample.ray;
   int depth = 0;
   bool specular_bounce = false;
@@ -234,8 +251,14 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
                                      Vec3(rng.next_float(), rng.next_float(), rng.next_float()))
               : leaf;
     }
+    // Next event estimation asks for the mixture density toward the light (not for a delta
+    // light); what it evaluated is kept for the record.
+    DirectionPdfs nee_pdfs;
+    bool nee_evaluated = false;
     auto mixture_pdf = [&](Vec3 wi) {
-      return mix.pdf(bsdf.pdf(wo, wi, TransportMode::Radiance), mix.guide_pdf(wi));
+      nee_pdfs = mix.evaluate(bsdf, wo, wi);
+      nee_evaluated = true;
+      return mix.pdf(nee_pdfs);
     };
 
     const float u_light = rng.next_float();
@@ -245,7 +268,8 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
         scene, si, bsdf, beta, u_light, u, mixture_pdf,
         [&](float a, float b) { return mis_weight(a, b); }, &seen));
     if (mix.guidable && !seen.Li.is_black())
-      learning.add_next_event(mix, seen, bsdf.pdf(wo, seen.wi, TransportMode::Radiance));
+      learning.add_next_event(mix, seen,
+                              nee_evaluated ? nee_pdfs : mix.evaluate(bsdf, wo, seen.wi));
 
     const float uc = rng.next_float();
     const Vec2 u_dir = rng.next_2d();
@@ -263,7 +287,19 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     prev_p = si.p;
     ray = si.spawn_ray(s->wi);
     if (beta.is_black()) break;
-    if (!survives_russian_roulette(beta, eta_scale, depth, rng)) break;
+    // Roulette on the larger of the throughput and the one BSDF sampling would have had: a
+    // guided direction toward bright light has a small weight (its density is high) and must
+    // not be ended for it, nor a path whose weight grew. Any survival probability that depends
+    // only on the path so far keeps the estimate unbiased.
+    rr_beta *= s->bsdf_weight;
+    const float q = russian_roulette_end(
+        Rgb(std::max(beta.r, rr_beta.r), std::max(beta.g, rr_beta.g), std::max(beta.b, rr_beta.b)),
+        eta_scale, depth);
+    if (q > 0) {
+      if (rng.next_float() < q) break;
+      beta = beta / (1 - q);
+      rr_beta = rr_beta / (1 - q);
+    }
   }
   learning.finish();
   passes_.add(sample.pixel, L * sample.filter_weight);

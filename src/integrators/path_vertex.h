@@ -109,13 +109,19 @@ Rgb direct_light_mis(const Scene& scene, const SurfaceInteraction& si, const Bsd
   return beta * d->f * d->ls.radiance * (w / light_pdf);
 }
 
-// Russian roulette after `depth` scattering vertices, on the throughput with the radiance
-// scaling of refraction (eta_scale) removed, never before the second vertex. Returns false when
-// the path ends; otherwise beta is divided by the survival probability.
-inline bool survives_russian_roulette(Rgb& beta, float eta_scale, int depth, Pcg32& rng) {
+// The probability q that Russian roulette ends a path after `depth` scattering vertices with
+// throughput beta: from the throughput with the radiance scaling of refraction (eta_scale)
+// removed, never before the second vertex; 0 means no roulette.
+inline float russian_roulette_end(Rgb beta, float eta_scale, int depth) {
   const float rr = (beta * eta_scale).max_component();
-  if (rr < 1 && depth > 1) {
-    const float q = std::max(0.f, 1 - rr);
+  return rr < 1 && depth > 1 ? std::max(0.f, 1 - rr) : 0.f;
+}
+
+// Russian roulette (russian_roulette_end). Returns false when the path ends; otherwise beta is
+// divided by the survival probability.
+inline bool survives_russian_roulette(Rgb& beta, float eta_scale, int depth, Pcg32& rng) {
+  const float q = russian_roulette_end(beta, eta_scale, depth);
+  if (q > 0) {
     if (rng.next_float() < q) return false;
     beta = beta / (1 - q);
   }

@@ -9,7 +9,7 @@ namespace caustica {
 
 namespace {
 
-double sum(const std::array<double, 4>& e) { return (e[0] + e[1]) + (e[2] + e[3]); }
+double sum(const std::array<float, 4>& e) { return (double(e[0]) + e[1]) + (double(e[2]) + e[3]); }
 
 }  // namespace
 
@@ -39,7 +39,7 @@ void DirectionalQuadtree::record(Vec2 p, double value) {
     y = 2 * y - iy;
     const uint32_t child = nodes_[node].child[q];
     if (!child) {
-      nodes_[node].energy[q] += value;
+      nodes_[node].energy[q] += float(value);
       return;
     }
     node = child;
@@ -90,31 +90,32 @@ void DirectionalQuadtree::record_box(uint32_t node, double ox, double oy, double
     if (const uint32_t child = nodes_[node].child[q])
       record_box(child, qx, qy, half, box, density);
     else
-      nodes_[node].energy[q] += density * w * h;
+      nodes_[node].energy[q] += float(density * w * h);
   }
 }
 
 void DirectionalQuadtree::propagate() {
   for (size_t i = nodes_.size(); i-- > 0;)
     for (int q = 0; q < 4; ++q)
-      if (const uint32_t c = nodes_[i].child[q]) nodes_[i].energy[q] = sum(nodes_[c].energy);
+      if (const uint32_t c = nodes_[i].child[q]) nodes_[i].energy[q] = float(sum(nodes_[c].energy));
 }
 
 // Each level multiplies the density by 4 (a quadrant has a quarter of its parent's area) times
 // the quadrant's share of the parent's energy.
 float DirectionalQuadtree::pdf_square(Vec2 p) const {
-  double x = p.x, y = p.y, pdf = 1;
+  double x = p.x, y = p.y;
+  float pdf = 1;
   uint32_t node = 0;
   for (;;) {
-    const std::array<double, 4>& e = nodes_[node].energy;
-    const double node_total = sum(e);
+    const std::array<float, 4>& e = nodes_[node].energy;
+    const float node_total = (e[0] + e[1]) + (e[2] + e[3]);
     if (!(node_total > 0)) return 0;
     const int ix = x >= 0.5, iy = y >= 0.5, q = ix + 2 * iy;
     pdf *= 4 * e[q] / node_total;
     x = 2 * x - ix;
     y = 2 * y - iy;
     const uint32_t child = nodes_[node].child[q];
-    if (!child) return float(pdf);
+    if (!child) return pdf;
     node = child;
   }
 }
@@ -131,8 +132,8 @@ Vec2 DirectionalQuadtree::sample_square(Vec2 u) const {
   double ox = 0, oy = 0, size = 1;
   uint32_t node = 0;
   for (;;) {
-    const std::array<double, 4>& e = nodes_[node].energy;
-    const double left = e[0] + e[2], node_total = left + (e[1] + e[3]);
+    const std::array<float, 4>& e = nodes_[node].energy;
+    const double left = double(e[0]) + e[2], node_total = left + (double(e[1]) + e[3]);
     const double p_left = left / node_total;
     int ix;
     if (ux < p_left) {
@@ -142,7 +143,7 @@ Vec2 DirectionalQuadtree::sample_square(Vec2 u) const {
       ix = 1;
       ux = (ux - p_left) / (1 - p_left);
     }
-    const double lower = e[ix], upper = e[ix + 2];
+    const double lower = e[ix], upper = e[ix + 2];  // promoted
     const double p_lower = lower / (lower + upper);
     int iy;
     if (uy < p_lower) {

@@ -26,7 +26,9 @@ Vec3 square_to_direction(Vec2 p);
 class DirectionalQuadtree {
  public:
   struct Node {
-    std::array<double, 4> energy{};   // per quadrant: recorded flux (inner: sum of its subtree)
+    // Per quadrant: recorded flux (inner: sum of its subtree). Float: a node is 32 bytes, and
+    // a sampling distribution needs no more precision.
+    std::array<float, 4> energy{};
     std::array<uint32_t, 4> child{};  // 0: the quadrant is a leaf
   };
 

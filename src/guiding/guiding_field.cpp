@@ -153,4 +153,10 @@ uint64_t GuidingField::counted_vertices() const {
   return n;
 }
 
+double GuidingField::mean_bsdf_fraction() const {
+  double sum = 0;
+  for (uint32_t i = 0; i < leaves_.size(); ++i) sum += bsdf_fraction(i);
+  return sum / double(leaves_.size());
+}
+
 }  // namespace caustica

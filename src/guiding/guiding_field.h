@@ -86,6 +86,8 @@ class GuidingField {
   size_t quadtree_node_count() const;
   size_t memory_bytes() const;
   uint64_t counted_vertices() const;  // in the current pass
+  // The mean over leaves of the BSDF selection probability (a statistic).
+  double mean_bsdf_fraction() const;
 
  private:
   // 8 bytes, so that the descent stays in cache: the two children of an inner node are

@@ -317,6 +317,7 @@ void GuidedPathTracer::report(nlohmann::json& stats) const {
   g["record_buffer_peak_bytes"] = peak_record_bytes_;
   g["pass_image_bytes"] = passes_.bytes();
   g["radiance_samples_recorded"] = recorded_;
+  g["mean_bsdf_fraction"] = field_.mean_bsdf_fraction();
   nlohmann::json passes = nlohmann::json::array();
   for (const InverseVarianceCombiner::Pass& p : passes_.passes())
     passes.push_back({{"spp", p.samples}, {"variance", p.variance}});

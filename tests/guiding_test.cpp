@@ -108,6 +108,18 @@ TEST(Guiding, SamplingFollowsPdfChiSquare) {
   EXPECT_TRUE(r.passed) << r.message << " p " << r.p_value;
 }
 
+// The density sample_square() reports is, bit for bit, pdf_square() at the sampled point.
+TEST(Guiding, SampledDensityIsThePdfAtTheSample) {
+  const GuidingField field = trained_cone(kCone);
+  const DirectionalQuadtree& d = field.sampling(field.leaf_at({0.5f, 0.5f, 0.5f}));
+  Pcg32 rng(9, 9);
+  for (int i = 0; i < 10000; ++i) {
+    float pdf = 0;
+    const Vec2 p = d.sample_square(rng.next_2d(), &pdf);
+    ASSERT_EQ(pdf, d.pdf_square(p));
+  }
+}
+
 // Trained on radiance concentrated in a cone, the learned density is much higher in the cone
 // than outside, and the cone's probability tends to its share of the energy as the quadtree
 // refines (smaller rho): leaves straddling the cone's rim spread its energy outside.

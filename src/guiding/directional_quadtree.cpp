@@ -13,9 +13,29 @@ double sum(const std::array<float, 4>& e) { return (double(e[0]) + e[1]) + (doub
 
 }  // namespace
 
+namespace {
+
+// atan2 by a minimax polynomial for atan on [0, 1] (maximum error 1.7e-6 radians): the mapping
+// runs for every guided direction, and std::atan2 was a noticeable share of the render.
+float fast_atan2(float y, float x) {
+  const float ax = std::abs(x), ay = std::abs(y);
+  const float hi = std::max(ax, ay), a = hi > 0 ? std::min(ax, ay) / hi : 0.f, s = a * a;
+  float r = -0.01172120f;
+  r = r * s + 0.05265332f;
+  r = r * s - 0.11643287f;
+  r = r * s + 0.19354346f;
+  r = r * s - 0.33262347f;
+  r = (r * s + 0.99997726f) * a;
+  if (ay > ax) r = 0.5f * kPi - r;
+  if (x < 0) r = kPi - r;
+  return y < 0 ? -r : r;
+}
+
+}  // namespace
+
 Vec2 direction_to_square(Vec3 w) {
   const float cos_theta = std::clamp(w.z, -1.f, 1.f);
-  float phi = std::atan2(w.y, w.x);
+  float phi = fast_atan2(w.y, w.x);
   if (phi < 0) phi += 2 * kPi;
   const float v = phi * (0.5f / kPi);
   return {std::clamp((cos_theta + 1) * 0.5f, 0.f, kOneMinusEpsilon),
@@ -127,9 +147,10 @@ float DirectionalQuadtree::pdf(Vec3 w) const {
 // Per level: the column (ix) with probability of its energy share, then the row (iy) within
 // the column; each rescales its coordinate of u to [0, 1), so the quadrant q is chosen with
 // probability e_q / total and u stays uniform for the next level.
-Vec2 DirectionalQuadtree::sample_square(Vec2 u) const {
+Vec2 DirectionalQuadtree::sample_square(Vec2 u, float* pdf) const {
   double ux = u.x, uy = u.y;
   double ox = 0, oy = 0, size = 1;
+  float density = 1;  // as pdf_square() computes it
   uint32_t node = 0;
   for (;;) {
     const std::array<float, 4>& e = nodes_[node].energy;
@@ -158,6 +179,7 @@ Vec2 DirectionalQuadtree::sample_square(Vec2 u) const {
     size *= 0.5;
     ox += ix * size;
     oy += iy * size;
+    density *= 4 * e[ix + 2 * iy] / ((e[0] + e[1]) + (e[2] + e[3]));
     const uint32_t child = nodes_[node].child[ix + 2 * iy];
     if (!child) break;
     node = child;
@@ -168,6 +190,7 @@ Vec2 DirectionalQuadtree::sample_square(Vec2 u) const {
     const float lo = float(origin), hi = float(origin + size);
     return std::clamp(float(origin + size * t), lo, std::nextafter(hi, lo));
   };
+  if (pdf) *pdf = density;
   return {inside(ox, ux), inside(oy, uy)};
 }
 

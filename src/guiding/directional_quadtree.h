@@ -52,8 +52,9 @@ class DirectionalQuadtree {
   float pdf_square(Vec2 p) const;
   float pdf(Vec3 w) const;
   // Hierarchical sample warping (Müller et al. 2017, sec. 3.3 and its appendix): u picks a
-  // quadrant per level and is rescaled; requires total() > 0.
-  Vec2 sample_square(Vec2 u) const;
+  // quadrant per level and is rescaled; requires total() > 0. With pdf, also the density on
+  // the square of the leaf it lands in: bit for bit what pdf_square() returns there.
+  Vec2 sample_square(Vec2 u, float* pdf = nullptr) const;
   Vec3 sample(Vec2 u) const { return square_to_direction(sample_square(u)); }
 
   // The structure for the next training iteration (Müller et al. 2017, sec. 3.4): a quadrant is

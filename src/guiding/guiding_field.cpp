@@ -13,6 +13,7 @@ GuidingField::GuidingField(Bounds3 bounds, const GuidingSettings& settings)
   leaves_.emplace_back();
   leaves_[0].box = bounds_;
   reset_counts();
+  refresh_guides();
 }
 
 void GuidingField::reset_counts() {
@@ -21,9 +22,21 @@ void GuidingField::reset_counts() {
 }
 
 uint32_t GuidingField::leaf_at(Vec3 p) const {
+  const float coordinate[4] = {p.x, p.y, p.z, 0};  // indexed without branches
   SpatialNode n = nodes_[0];
-  while (n.axis() != SpatialNode::kLeaf) n = nodes_[n.index() + (p[int(n.axis())] >= n.middle)];
+  while (n.axis() != SpatialNode::kLeaf) n = nodes_[n.index() + (coordinate[n.axis()] >= n.middle)];
   return n.index();
+}
+
+void GuidingField::refresh_guides() {
+  if (guides_.size() != leaves_.size()) {
+    guides_.resize(leaves_.size());
+    guides_.shrink_to_fit();
+  }
+  for (uint32_t i = 0; i < leaves_.size(); ++i) {
+    const Leaf& l = leaves_[i];
+    guides_[i] = {l.sampling.total() > 0 ? &l.sampling : nullptr, bsdf_fraction(i)};
+  }
 }
 
 uint32_t GuidingField::jittered_leaf(Vec3 p, uint32_t leaf, Vec3 u) const {
@@ -39,6 +52,7 @@ float GuidingField::bsdf_fraction(uint32_t leaf) const {
 void GuidingField::record(const GuidingRecord& r) {
   if (r.statistical_weight > 0) count_vertex(r.leaf);
   record_into(leaves_[r.leaf], r);
+  guides_[r.leaf].bsdf_fraction = bsdf_fraction(r.leaf);
 }
 
 void GuidingField::record_into(Leaf& leaf, const GuidingRecord& r) {
@@ -66,6 +80,7 @@ void GuidingField::splat(std::vector<GuidingRecord>& records) {
     Leaf& leaf = leaves_[records[starts[g]].leaf];
     for (size_t i = starts[g]; i < starts[g + 1]; ++i) record_into(leaf, records[i]);
   });
+  refresh_guides();
 }
 
 // Müller et al. 2017, sec. 3.4: "we subdivide a leaf node if it contains more than
@@ -93,8 +108,8 @@ void GuidingField::split(uint32_t node, std::vector<uint64_t>& counts) {
 }
 
 size_t GuidingField::leaf_bytes(const Leaf& l) const {
-  return sizeof(Leaf) + 2 * sizeof(SpatialNode) + sizeof(uint64_t) + l.sampling.bytes() +
-         l.recording.bytes();
+  return sizeof(Leaf) + 2 * sizeof(SpatialNode) + sizeof(uint64_t) + sizeof(Guide) +
+         l.sampling.bytes() + l.recording.bytes();
 }
 
 void GuidingField::split_leaves(int k) {
@@ -123,6 +138,7 @@ void GuidingField::end_pass(int k) {
     l.recording = DirectionalQuadtree();
   }
   split_leaves(k);
+  refresh_guides();  // leaves_ moved: the pointers change
   const size_t bytes = memory_bytes();
   size_t budget = settings_.max_bytes > bytes
                       ? (settings_.max_bytes - bytes) / DirectionalQuadtree::kNodeBytes
@@ -142,7 +158,8 @@ size_t GuidingField::quadtree_node_count() const {
 
 size_t GuidingField::memory_bytes() const {
   size_t bytes = nodes_.capacity() * sizeof(SpatialNode) + leaves_.capacity() * sizeof(Leaf) +
-                 leaves_.size() * sizeof(std::atomic<uint64_t>);
+                 leaves_.size() * sizeof(std::atomic<uint64_t>) +
+                 guides_.capacity() * sizeof(Guide);
   for (const Leaf& l : leaves_) bytes += l.sampling.bytes() + l.recording.bytes();
   return bytes;
 }

@@ -67,6 +67,14 @@ class GuidingField {
   const DirectionalQuadtree& sampling(uint32_t leaf) const { return leaves_[leaf].sampling; }
   // The probability of sampling the BSDF at the leaf (fixed, or learned: guiding_settings.h).
   float bsdf_fraction(uint32_t leaf) const;
+  // What a vertex in the leaf samples with, in one small record read per vertex: the learned
+  // distribution (nullptr until the leaf has learned radiance) and the BSDF selection
+  // probability. Refreshed by splat() and end_pass().
+  struct Guide {
+    const DirectionalQuadtree* distribution = nullptr;
+    float bsdf_fraction = 1;
+  };
+  const Guide& guide(uint32_t leaf) const { return guides_[leaf]; }
 
   // Counts a path vertex at a leaf for the split rule (from any thread: the count is an
   // integer, so it does not depend on the order). Every guided vertex counts, whether or not it
@@ -116,6 +124,8 @@ class GuidingField {
   // Path vertices per leaf in the current pass (count_vertex()).
   mutable std::unique_ptr<std::atomic<uint64_t>[]> counts_;
   void reset_counts();
+  std::vector<Guide> guides_;  // per leaf
+  void refresh_guides();
 };
 
 }  // namespace caustica

@@ -15,8 +15,6 @@ double logistic(double x) { return 1 / (1 + std::exp(-x)); }
 
 }  // namespace
 
-float SelectionOptimizer::bsdf_fraction() const { return float(logistic(theta_)); }
-
 void SelectionOptimizer::add(float product_over_pdf, float bsdf_pdf, float guide_pdf,
                              float statistical_weight) {
   const double alpha = logistic(theta_);
@@ -42,6 +40,7 @@ void SelectionOptimizer::step(double gradient) {
   second_moment_ = kBeta2 * second_moment_ + (1 - kBeta2) * gradient * gradient;
   theta_ -= rate * first_moment_ / (std::sqrt(second_moment_) + kEpsilon);
   theta_ = std::clamp(theta_, -kThetaBound, kThetaBound);
+  fraction_ = float(logistic(theta_));
 }
 
 }  // namespace caustica

@@ -18,7 +18,7 @@ namespace caustica {
 class SelectionOptimizer {
  public:
   // The probability of sampling the BSDF. Starts at 0.5 (theta = 0).
-  float bsdf_fraction() const;
+  float bsdf_fraction() const { return fraction_; }
   // One sample: the product over the density it was sampled with (P / p_s), and the BSDF's and
   // the learned distribution's densities at its direction (solid angle).
   void add(float product_over_pdf, float bsdf_pdf, float guide_pdf, float statistical_weight);
@@ -28,6 +28,7 @@ class SelectionOptimizer {
   void step(double gradient);
 
   double theta_ = 0;
+  float fraction_ = 0.5f;  // logistic(theta_)
   double first_moment_ = 0, second_moment_ = 0;
   int steps_ = 0;
   double batch_gradient_ = 0, batch_weight_ = 0;

@@ -63,7 +63,12 @@ std::optional<MixtureSample> sample_mixture(const Bsdf& bsdf, Vec3 wo, const Mix
                                             float u_technique, float uc, Vec2 u) {
   MixtureSample s;
   if (m.guide && u_technique >= m.bsdf_fraction) {
-    s.wi = m.guide->sample(u);
+    // The sampled point's leaf density is the guide's density of the direction (the round trip
+    // through direction_to_square() agrees but within float rounding at leaf borders).
+    float guide_pdf;
+    const Vec2 square = m.guide->sample_square(u, &guide_pdf);
+    s.wi = square_to_direction(square);
+    s.pdfs = {square, bsdf.pdf(wo, s.wi, TransportMode::Radiance), guide_pdf * kInv4Pi};
   } else {
     const auto bs = bsdf.sample(wo, uc, u, TransportMode::Radiance);
     if (!bs) return std::nullopt;
@@ -76,8 +81,8 @@ std::optional<MixtureSample> sample_mixture(const Bsdf& bsdf, Vec3 wo, const Mix
       if (m.guidable) s.pdfs = {direction_to_square(s.wi), s.pdf, 0.f};
       return s;
     }
+    s.pdfs = m.evaluate(bsdf, wo, s.wi);
   }
-  s.pdfs = m.evaluate(bsdf, wo, s.wi);
   s.pdf = m.pdf(s.pdfs);
   if (!(s.pdf > 0)) return std::nullopt;
   const Rgb f_cos = bsdf.f(wo, s.wi, TransportMode::Radiance) * bsdf.abs_cos(s.wi);
@@ -241,9 +246,10 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     mix.guidable = !is_specular(bsdf.flags()) && !bsdf.is_delta() && !bsdf.stochastic();
     if (mix.guidable) {
       const uint32_t leaf = field_.leaf_at(si.p);
-      if (field_.sampling(leaf).total() > 0) {
-        mix.guide = &field_.sampling(leaf);
-        mix.bsdf_fraction = field_.bsdf_fraction(leaf);
+      const GuidingField::Guide& guide = field_.guide(leaf);
+      if (guide.distribution) {
+        mix.guide = guide.distribution;
+        mix.bsdf_fraction = guide.bsdf_fraction;
       }
       mix.record_leaf =
           settings_.guiding.filter

@@ -12,13 +12,12 @@ GuidingField::GuidingField(Bounds3 bounds, const GuidingSettings& settings)
   nodes_.emplace_back();  // a leaf: leaves_[0]
   leaves_.emplace_back();
   leaves_[0].box = bounds_;
-  reset_counts();
+  counts_.assign(1, 0);
   refresh_guides();
 }
 
-void GuidingField::reset_counts() {
-  counts_ = std::make_unique<std::atomic<uint64_t>[]>(leaves_.size());
-  for (size_t i = 0; i < leaves_.size(); ++i) counts_[i].store(0, std::memory_order_relaxed);
+void GuidingField::add_vertex_counts(const std::vector<uint32_t>& counts) {
+  for (size_t i = 0; i < counts.size() && i < counts_.size(); ++i) counts_[i] += counts[i];
 }
 
 uint32_t GuidingField::leaf_at(Vec3 p) const {
@@ -50,7 +49,7 @@ float GuidingField::bsdf_fraction(uint32_t leaf) const {
 }
 
 void GuidingField::record(const GuidingRecord& r) {
-  if (r.statistical_weight > 0) count_vertex(r.leaf);
+  if (r.statistical_weight > 0) ++counts_[r.leaf];
   record_into(leaves_[r.leaf], r);
   guides_[r.leaf].bsdf_fraction = bsdf_fraction(r.leaf);
 }
@@ -115,8 +114,7 @@ size_t GuidingField::leaf_bytes(const Leaf& l) const {
 void GuidingField::split_leaves(int k) {
   const double threshold = settings_.spatial_threshold * std::sqrt(std::ldexp(1.0, k));
   size_t bytes = memory_bytes();
-  std::vector<uint64_t> counts(leaves_.size());
-  for (size_t i = 0; i < leaves_.size(); ++i) counts[i] = counts_[i].load();
+  std::vector<uint64_t>& counts = counts_;
   // nodes_ grows inside the loop: new children are visited too, so a leaf splits repeatedly.
   for (uint32_t i = 0; i < nodes_.size(); ++i) {
     if (nodes_[i].axis() != SpatialNode::kLeaf) continue;
@@ -147,7 +145,8 @@ void GuidingField::end_pass(int k) {
     l.recording = l.sampling.refined(settings_.rho, settings_.max_quadtree_depth, &budget);
     l.recording.shrink_to_fit();
   }
-  reset_counts();
+  counts_.assign(leaves_.size(), 0);
+  counts_.shrink_to_fit();
 }
 
 size_t GuidingField::quadtree_node_count() const {
@@ -158,15 +157,14 @@ size_t GuidingField::quadtree_node_count() const {
 
 size_t GuidingField::memory_bytes() const {
   size_t bytes = nodes_.capacity() * sizeof(SpatialNode) + leaves_.capacity() * sizeof(Leaf) +
-                 leaves_.size() * sizeof(std::atomic<uint64_t>) +
-                 guides_.capacity() * sizeof(Guide);
+                 counts_.capacity() * sizeof(uint64_t) + guides_.capacity() * sizeof(Guide);
   for (const Leaf& l : leaves_) bytes += l.sampling.bytes() + l.recording.bytes();
   return bytes;
 }
 
 uint64_t GuidingField::counted_vertices() const {
   uint64_t n = 0;
-  for (size_t i = 0; i < leaves_.size(); ++i) n += counts_[i].load();
+  for (uint64_t c : counts_) n += c;
   return n;
 }
 

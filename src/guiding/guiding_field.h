@@ -23,10 +23,8 @@
 // parallel, each leaf's records in that order: the field does not depend on thread scheduling.
 #pragma once
 
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <memory>
 #include <vector>
 
 #include "core/vec.h"
@@ -76,10 +74,10 @@ class GuidingField {
   };
   const Guide& guide(uint32_t leaf) const { return guides_[leaf]; }
 
-  // Counts a path vertex at a leaf for the split rule (from any thread: the count is an
-  // integer, so it does not depend on the order). Every guided vertex counts, whether or not it
-  // found radiance (Müller et al. 2017: "path vertices").
-  void count_vertex(uint32_t leaf) const { counts_[leaf].fetch_add(1, std::memory_order_relaxed); }
+  // Adds path vertex counts per leaf (counts[leaf], as many as leaf_count()) for the split
+  // rule. Every guided vertex counts, whether or not it found radiance (Müller et al. 2017:
+  // "path vertices"). Callers count per thread and add the integers in any order.
+  void add_vertex_counts(const std::vector<uint32_t>& counts);
   // Records one sample directly (sequential; tests), counting it as a vertex when its
   // statistical weight is positive.
   void record(const GuidingRecord& r);
@@ -121,10 +119,8 @@ class GuidingField {
   Bounds3 bounds_;
   std::vector<SpatialNode> nodes_;  // nodes_[0] is the root
   std::vector<Leaf> leaves_;
-  // Path vertices per leaf in the current pass (count_vertex()).
-  mutable std::unique_ptr<std::atomic<uint64_t>[]> counts_;
-  void reset_counts();
-  std::vector<Guide> guides_;  // per leaf
+  std::vector<uint64_t> counts_;  // path vertices per leaf in the current pass
+  std::vector<Guide> guides_;     // per leaf
   void refresh_guides();
 };
 

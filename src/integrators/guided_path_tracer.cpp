@@ -199,6 +199,10 @@ void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, 
   for (const std::vector<GuidingRecord>& r : records_)
     bytes += r.capacity() * sizeof(GuidingRecord);
   peak_record_bytes_ = std::max(peak_record_bytes_, bytes);
+  for (std::vector<uint32_t>& counts : vertex_counts_) {
+    field_.add_vertex_counts(counts);
+    std::fill(counts.begin(), counts.end(), 0);
+  }
   field_.splat(merged_);
   recorded_ += merged_.size();
 }
@@ -213,6 +217,8 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
                                ScratchArena& arena, uint64_t*) const {
   const LightSampler& lights = scene.light_sampler();
   PathLearning learning(arena, settings_.max_depth, sample.pixel, records_.local());
+  std::vector<uint32_t>& vertex_counts = vertex_counts_.local();
+  if (vertex_counts.size() != field_.leaf_count()) vertex_counts.assign(field_.leaf_count(), 0);
   Rgb L(0.f), beta(1.f);
   Rgb rr_beta(1.f);  // the throughput of BSDF sampling, for Russian roulette
   Ray ray = sample.ray;
@@ -285,7 +291,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     eta_scale *= s->eta2;
     beta *= s->weight;
     if (mix.guidable) {
-      field_.count_vertex(mix.record_leaf);
+      ++vertex_counts[mix.record_leaf];
       learning.add_vertex(mix, *s, beta);
     }
     prev_pdf = s->pdf;

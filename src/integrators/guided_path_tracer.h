@@ -77,6 +77,8 @@ class GuidedPathTracer final : public CameraPathIntegrator {
   uint64_t recorded_ = 0;
   size_t peak_record_bytes_ = 0;
   mutable tbb::enumerable_thread_specific<std::vector<GuidingRecord>> records_;
+  // Path vertices per spatial leaf, per thread (added to the field after each iteration).
+  mutable tbb::enumerable_thread_specific<std::vector<uint32_t>> vertex_counts_;
   std::vector<GuidingRecord> merged_;
   // Written by estimate(): one writer per pixel at a time.
   mutable InverseVarianceCombiner passes_;

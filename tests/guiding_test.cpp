@@ -48,6 +48,7 @@ void train(GuidingField& field, const std::function<ConeField(Vec3)>& scene, int
       const Vec3 w = guided && rng.next_float() < 0.5f ? learned.sample(u) : square_to_direction(u);
       const float pdf = guided ? 0.5f * kInv4Pi + 0.5f * learned.pdf(w) : kInv4Pi;
       GuidingRecord r;
+      r.key = (uint64_t(k) << 32) + uint64_t(i);  // unique: the filter's jitter is hashed from it
       r.leaf = field.leaf_at(p);
       r.square = direction_to_square(w);
       r.radiance = scene(p).radiance(w) / pdf;
@@ -195,6 +196,30 @@ TEST(Guiding, FilteredSplatConservesEnergy) {
   flat.record_filtered({0.25f, 0.25f}, 1.0);
   flat.propagate();
   EXPECT_NEAR(flat.pdf_square({0.25f, 0.25f}), 4.0, 1e-6);
+}
+
+// The stochastic directional filter (the one the field uses) is the deterministic box filter
+// in expectation: many jittered splats of one point match one box-filtered splat.
+TEST(Guiding, JitteredSplatsAverageToTheBoxFilter) {
+  const GuidingField field = trained_cone(kCone, 4);
+  size_t budget = 100000;
+  const DirectionalQuadtree refined = field.sampling(0).refined(0.01, 20, &budget);
+  const Vec2 points[] = {direction_to_square(kCone.axis), {0.4f, 0.999f}, {0.001f, 0.3f}};
+  for (Vec2 p : points) {
+    DirectionalQuadtree box = refined, jittered = refined;
+    box.record_filtered(p, 1.0);
+    Pcg32 rng(4, 5);
+    const int n = 200000;
+    for (int i = 0; i < n; ++i) jittered.record_jittered(p, 1.0 / n, rng.next_2d());
+    box.propagate();
+    jittered.propagate();
+    for (int i = 0; i < 200; ++i) {
+      const Vec2 q = rng.next_2d();
+      const float a = box.pdf_square(q), b = jittered.pdf_square(q);
+      ASSERT_NEAR(a, b, 0.02 * std::max(a, 1.f))
+          << p.x << " " << p.y << " at " << q.x << " " << q.y;
+    }
+  }
 }
 
 // Splatting the same records in any order (as threads would produce them) gives the same field,

@@ -99,6 +99,17 @@ void DirectionalQuadtree::record_filtered(Vec2 p, double value) {
   }
 }
 
+void DirectionalQuadtree::record_jittered(Vec2 p, double value, Vec2 u) {
+  const double size = leaf_size(p);
+  double x = p.x + (u.x - 0.5) * size, y = p.y + (u.y - 0.5) * size;
+  if (x < 0) x = -x;
+  if (x >= 1) x = 2 - x;
+  y -= std::floor(y);
+  record(Vec2(float(std::clamp(x, 0.0, double(kOneMinusEpsilon))),
+              float(std::clamp(y, 0.0, double(kOneMinusEpsilon)))),
+         value);
+}
+
 void DirectionalQuadtree::record_box(uint32_t node, double ox, double oy, double size,
                                      const double box[4], double density) {
   const double half = size / 2;

@@ -45,6 +45,10 @@ class DirectionalQuadtree {
   // centred at p, in proportion to its overlap with each leaf quadrant. The square is moved
   // inside the unit square in u (cos theta) and wraps around in v (phi), so no energy is lost.
   void record_filtered(Vec2 p, double value);
+  // The same filter stochastically: `value` recorded at p moved by (u - 1/2) times that side
+  // (reflected back into the square in u, wrapped in v). Its expectation over u in [0, 1)^2 is
+  // record_filtered(); it costs two descents instead of a walk over every overlapped quadrant.
+  void record_jittered(Vec2 p, double value, Vec2 u);
   // Recomputes inner nodes' energies from the leaves (bottom up).
   void propagate();
 

@@ -3,9 +3,24 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace caustica {
+
+namespace {
+
+// SplitMix64's finalizer: a well-mixed 64-bit hash of a record's key.
+uint64_t mix_bits(uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ull;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+}  // namespace
 
 GuidingField::GuidingField(Bounds3 bounds, const GuidingSettings& settings)
     : settings_(settings), bounds_(bounds.empty() ? Bounds3{{0, 0, 0}, {1, 1, 1}} : bounds) {
@@ -56,21 +71,35 @@ void GuidingField::record(const GuidingRecord& r) {
 
 void GuidingField::record_into(Leaf& leaf, const GuidingRecord& r) {
   if (r.radiance > 0 && std::isfinite(r.radiance)) {
-    if (settings_.filter)
-      leaf.recording.record_filtered(r.square, r.radiance);
-    else
+    if (settings_.filter) {
+      // The directional box filter, stochastically, with a jitter hashed from the record's key.
+      const uint64_t h = mix_bits(r.key);
+      const Vec2 u(float(h >> 40) * 0x1p-24f, float((h >> 16) & 0xffffff) * 0x1p-24f);
+      leaf.recording.record_jittered(r.square, r.radiance, u);
+    } else {
       leaf.recording.record(r.square, r.radiance);
+    }
   }
   if (settings_.bsdf_fraction < 0 && r.guide_pdf > 0 && r.product > 0)
     leaf.selection.add(r.product, r.bsdf_pdf, r.guide_pdf, r.statistical_weight);
 }
 
 void GuidingField::splat(std::vector<GuidingRecord>& records) {
-  // (leaf, key) is unique for the caller's keys, so any sort gives the same order.
-  tbb::parallel_sort(records.begin(), records.end(),
-                     [](const GuidingRecord& a, const GuidingRecord& b) {
-                       return a.leaf != b.leaf ? a.leaf < b.leaf : a.key < b.key;
-                     });
+  // (leaf, key) is unique for the caller's keys, so any sort gives the same order. Sorted as
+  // one 64-bit number (radix sort) when leaf and key fit (leaf < 2^22, key < 2^42).
+  bool packed = leaves_.size() <= (uint64_t(1) << 22);
+  uint64_t largest_key = 0;
+  for (const GuidingRecord& r : records) largest_key = std::max(largest_key, r.key);
+  packed = packed && largest_key < (uint64_t(1) << 42);
+  if (packed) {
+    for (GuidingRecord& r : records) r.key |= uint64_t(r.leaf) << 42;
+    radix_sort_by_key(records, (uint64_t(leaves_.size()) << 42) - 1);
+  } else {
+    tbb::parallel_sort(records.begin(), records.end(),
+                       [](const GuidingRecord& a, const GuidingRecord& b) {
+                         return a.leaf != b.leaf ? a.leaf < b.leaf : a.key < b.key;
+                       });
+  }
   std::vector<size_t> starts;
   for (size_t i = 0; i < records.size(); ++i)
     if (i == 0 || records[i].leaf != records[i - 1].leaf) starts.push_back(i);
@@ -80,6 +109,23 @@ void GuidingField::splat(std::vector<GuidingRecord>& records) {
     for (size_t i = starts[g]; i < starts[g + 1]; ++i) record_into(leaf, records[i]);
   });
   refresh_guides();
+}
+
+// LSD radix sort by key, 11-bit digits, over the bits up to the highest set in max_key.
+void GuidingField::radix_sort_by_key(std::vector<GuidingRecord>& records, uint64_t max_key) {
+  constexpr int kBits = 11;
+  constexpr size_t kBuckets = size_t(1) << kBits;
+  scratch_.resize(records.size());
+  std::vector<size_t> offsets(kBuckets);
+  for (int shift = 0; shift < 64 && (max_key >> shift) != 0; shift += kBits) {
+    std::fill(offsets.begin(), offsets.end(), 0);
+    for (const GuidingRecord& r : records) ++offsets[(r.key >> shift) & (kBuckets - 1)];
+    size_t sum = 0;
+    for (size_t& o : offsets) sum += std::exchange(o, sum);
+    for (const GuidingRecord& r : records)
+      scratch_[offsets[(r.key >> shift) & (kBuckets - 1)]++] = r;
+    records.swap(scratch_);
+  }
 }
 
 // Müller et al. 2017, sec. 3.4: "we subdivide a leaf node if it contains more than

@@ -111,6 +111,7 @@ class GuidingField {
     SelectionOptimizer selection;
   };
   void record_into(Leaf& leaf, const GuidingRecord& r);
+  void radix_sort_by_key(std::vector<GuidingRecord>& records, uint64_t max_key);
   void split(uint32_t node, std::vector<uint64_t>& counts);
   void split_leaves(int k);
   size_t leaf_bytes(const Leaf& l) const;
@@ -119,8 +120,9 @@ class GuidingField {
   Bounds3 bounds_;
   std::vector<SpatialNode> nodes_;  // nodes_[0] is the root
   std::vector<Leaf> leaves_;
-  std::vector<uint64_t> counts_;  // path vertices per leaf in the current pass
-  std::vector<Guide> guides_;     // per leaf
+  std::vector<uint64_t> counts_;        // path vertices per leaf in the current pass
+  std::vector<Guide> guides_;           // per leaf
+  std::vector<GuidingRecord> scratch_;  // the radix sort's other buffer
   void refresh_guides();
 };
 

@@ -33,9 +33,9 @@ void SelectionOptimizer::add(float product_over_pdf, float bsdf_pdf, float guide
 }
 
 void SelectionOptimizer::step(double gradient) {
-  ++steps_;
-  const double rate =
-      kLearningRate * std::sqrt(1 - std::pow(kBeta2, steps_)) / (1 - std::pow(kBeta1, steps_));
+  beta1_power_ *= kBeta1;
+  beta2_power_ *= kBeta2;
+  const double rate = kLearningRate * std::sqrt(1 - beta2_power_) / (1 - beta1_power_);
   first_moment_ = kBeta1 * first_moment_ + (1 - kBeta1) * gradient;
   second_moment_ = kBeta2 * second_moment_ + (1 - kBeta2) * gradient * gradient;
   theta_ -= rate * first_moment_ / (std::sqrt(second_moment_) + kEpsilon);

@@ -30,7 +30,7 @@ class SelectionOptimizer {
   double theta_ = 0;
   float fraction_ = 0.5f;  // logistic(theta_)
   double first_moment_ = 0, second_moment_ = 0;
-  int steps_ = 0;
+  double beta1_power_ = 1, beta2_power_ = 1;  // beta1^steps, beta2^steps
   double batch_gradient_ = 0, batch_weight_ = 0;
 };
 

@@ -91,6 +91,44 @@ std::optional<MixtureSample> sample_mixture(const Bsdf& bsdf, Vec3 wo, const Mix
   return s;
 }
 
+// The mixture at a vertex at p: guided where the BSDF has neither delta nor near-specular lobes
+// and is not stochastic, with the distribution and selection probability of p's leaf; its
+// records go to the leaf of p jittered by the leaf's size (the spatial box filter).
+Mixture mixture_at(const GuidingField& field, bool filter, Vec3 p, const Bsdf& bsdf, Pcg32& rng) {
+  Mixture mix;
+  mix.guidable = !is_specular(bsdf.flags()) && !bsdf.is_delta() && !bsdf.stochastic();
+  if (!mix.guidable) return mix;
+  const uint32_t leaf = field.leaf_at(p);
+  const GuidingField::Guide& guide = field.guide(leaf);
+  if (guide.distribution) {
+    mix.guide = guide.distribution;
+    mix.bsdf_fraction = guide.bsdf_fraction;
+  }
+  mix.record_leaf = leaf;
+  if (filter) {
+    const float ux = rng.next_float(), uy = rng.next_float(), uz = rng.next_float();
+    mix.record_leaf = field.jittered_leaf(p, leaf, Vec3(ux, uy, uz));
+  }
+  return mix;
+}
+
+// Roulette on the larger of the throughput and the one BSDF sampling alone would have had
+// (rr_beta): a guided direction toward bright light has a small weight (its density is high) and
+// must not be ended for it, nor a path whose weight grew. Any survival probability that depends
+// only on the path so far keeps the estimate unbiased. Returns false when the path ends; else
+// both throughputs are divided by the survival probability.
+bool survives_guided_roulette(Rgb& beta, Rgb& rr_beta, float eta_scale, int depth, Pcg32& rng) {
+  const Rgb larger(std::max(beta.r, rr_beta.r), std::max(beta.g, rr_beta.g),
+                   std::max(beta.b, rr_beta.b));
+  const float q = russian_roulette_end(larger, eta_scale, depth);
+  if (q > 0) {
+    if (rng.next_float() < q) return false;
+    beta = beta / (1 - q);
+    rr_beta = rr_beta / (1 - q);
+  }
+  return true;
+}
+
 // A guided vertex whose incident radiance along wi is recorded once the path is done.
 struct GuidedVertex {
   GuidingRecord record;  // radiance and product filled in at the end
@@ -126,7 +164,10 @@ class PathLearning {
   // technique's share of the incident radiance's flux estimate.
   void add_next_event(const Mixture& m, const NextEventSeen& seen, const DirectionPdfs& pdfs) {
     GuidingRecord r = base_record(m, pdfs);
-    if (seen.delta_light) r.guide_pdf = 0;  // not a solid-angle sample: no selection gradient
+    // No selection gradient: the mixture need not find what next event estimation already
+    // samples well (its share of direct light); the path records' product holds only the
+    // direction sampling's own MIS-weighted share.
+    r.guide_pdf = 0;
     const float scale = seen.weight / seen.light_pdf;
     r.radiance = seen.Li.luminance() * scale;
     r.product = (seen.f * seen.Li).luminance() * scale;
@@ -248,21 +289,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     if (depth++ == settings_.max_depth) break;
 
     const Vec3 wo = si.wo;
-    Mixture mix;
-    mix.guidable = !is_specular(bsdf.flags()) && !bsdf.is_delta() && !bsdf.stochastic();
-    if (mix.guidable) {
-      const uint32_t leaf = field_.leaf_at(si.p);
-      const GuidingField::Guide& guide = field_.guide(leaf);
-      if (guide.distribution) {
-        mix.guide = guide.distribution;
-        mix.bsdf_fraction = guide.bsdf_fraction;
-      }
-      mix.record_leaf =
-          settings_.guiding.filter
-              ? field_.jittered_leaf(si.p, leaf,
-                                     Vec3(rng.next_float(), rng.next_float(), rng.next_float()))
-              : leaf;
-    }
+    const Mixture mix = mixture_at(field_, settings_.guiding.filter, si.p, bsdf, rng);
     // Next event estimation asks for the mixture density toward the light (not for a delta
     // light); what it evaluated is kept for the record.
     DirectionPdfs nee_pdfs;
@@ -299,19 +326,8 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     prev_p = si.p;
     ray = si.spawn_ray(s->wi);
     if (beta.is_black()) break;
-    // Roulette on the larger of the throughput and the one BSDF sampling would have had: a
-    // guided direction toward bright light has a small weight (its density is high) and must
-    // not be ended for it, nor a path whose weight grew. Any survival probability that depends
-    // only on the path so far keeps the estimate unbiased.
     rr_beta *= s->bsdf_weight;
-    const float q = russian_roulette_end(
-        Rgb(std::max(beta.r, rr_beta.r), std::max(beta.g, rr_beta.g), std::max(beta.b, rr_beta.b)),
-        eta_scale, depth);
-    if (q > 0) {
-      if (rng.next_float() < q) break;
-      beta = beta / (1 - q);
-      rr_beta = rr_beta / (1 - q);
-    }
+    if (!survives_guided_roulette(beta, rr_beta, eta_scale, depth, rng)) break;
   }
   learning.finish();
   passes_.add(sample.pixel, L * sample.filter_weight);

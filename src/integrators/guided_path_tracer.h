@@ -21,6 +21,10 @@
 // the incident radiance's integral over each quadrant. Vertices whose estimate is zero are not
 // recorded (as Müller's implementation). Filtered splatting: guiding_settings.h.
 //
+// Russian roulette runs on the larger of the throughput and the throughput BSDF sampling alone
+// would have had (throughput roulette ends guided paths toward bright light for their small
+// weight, which is exactly what guiding found).
+//
 // Training schedule: iteration i (one sample per pixel) belongs to pass p = floor(log2(i + 1)),
 // so pass p covers iterations [2^p - 1, 2^(p+1) - 1): 1, 2, 4, 8, ... samples per pixel, as the
 // paper's doubling training iterations. A pass samples with the distribution learned by the

@@ -4,6 +4,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <utility>
 
@@ -86,14 +87,14 @@ void GuidingField::record_into(Leaf& leaf, const GuidingRecord& r) {
 
 void GuidingField::splat(std::vector<GuidingRecord>& records) {
   // (leaf, key) is unique for the caller's keys, so any sort gives the same order. Sorted as
-  // one 64-bit number (radix sort) when leaf and key fit (leaf < 2^22, key < 2^42).
-  bool packed = leaves_.size() <= (uint64_t(1) << 22);
+  // one 64-bit number (a radix sort over just the bits in use) when leaf and key fit.
   uint64_t largest_key = 0;
   for (const GuidingRecord& r : records) largest_key = std::max(largest_key, r.key);
-  packed = packed && largest_key < (uint64_t(1) << 42);
-  if (packed) {
-    for (GuidingRecord& r : records) r.key |= uint64_t(r.leaf) << 42;
-    radix_sort_by_key(records, (uint64_t(leaves_.size()) << 42) - 1);
+  const int key_bits = std::bit_width(largest_key);
+  const int bits = key_bits + std::bit_width(uint64_t(leaves_.size()));
+  if (bits <= 64) {
+    for (GuidingRecord& r : records) r.key |= uint64_t(r.leaf) << key_bits;
+    radix_sort_by_key(records, bits);
   } else {
     tbb::parallel_sort(records.begin(), records.end(),
                        [](const GuidingRecord& a, const GuidingRecord& b) {
@@ -111,19 +112,34 @@ void GuidingField::splat(std::vector<GuidingRecord>& records) {
   refresh_guides();
 }
 
-// LSD radix sort by key, 11-bit digits, over the bits up to the highest set in max_key.
-void GuidingField::radix_sort_by_key(std::vector<GuidingRecord>& records, uint64_t max_key) {
-  constexpr int kBits = 11;
-  constexpr size_t kBuckets = size_t(1) << kBits;
+// LSD radix sort by key (stable; keys below 2^bits), 11-bit digits. Each pass counts and
+// scatters a fixed number of chunks in parallel (chunk c of bucket b goes after every earlier
+// chunk of b), so the result is the same for any thread count.
+void GuidingField::radix_sort_by_key(std::vector<GuidingRecord>& records, int bits) {
+  constexpr int kDigit = 11;
+  constexpr size_t kBuckets = size_t(1) << kDigit, kChunks = 16;
   scratch_.resize(records.size());
-  std::vector<size_t> offsets(kBuckets);
-  for (int shift = 0; shift < 64 && (max_key >> shift) != 0; shift += kBits) {
+  const size_t chunk = (records.size() + kChunks - 1) / kChunks;
+  std::vector<size_t> offsets(kChunks * kBuckets);
+  for (int shift = 0; shift < bits; shift += kDigit) {
+    auto digit = [shift](const GuidingRecord& r) { return (r.key >> shift) & (kBuckets - 1); };
+    auto for_chunks = [&](auto&& fn) {
+      tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
+        const size_t begin = std::min(records.size(), c * chunk);
+        fn(c, begin, std::min(records.size(), begin + chunk));
+      });
+    };
     std::fill(offsets.begin(), offsets.end(), 0);
-    for (const GuidingRecord& r : records) ++offsets[(r.key >> shift) & (kBuckets - 1)];
+    for_chunks([&](size_t c, size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) ++offsets[c * kBuckets + digit(records[i])];
+    });
     size_t sum = 0;
-    for (size_t& o : offsets) sum += std::exchange(o, sum);
-    for (const GuidingRecord& r : records)
-      scratch_[offsets[(r.key >> shift) & (kBuckets - 1)]++] = r;
+    for (size_t b = 0; b < kBuckets; ++b)
+      for (size_t c = 0; c < kChunks; ++c) sum += std::exchange(offsets[c * kBuckets + b], sum);
+    for_chunks([&](size_t c, size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i)
+        scratch_[offsets[c * kBuckets + digit(records[i])]++] = records[i];
+    });
     records.swap(scratch_);
   }
 }

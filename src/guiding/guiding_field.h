@@ -111,7 +111,7 @@ class GuidingField {
     SelectionOptimizer selection;
   };
   void record_into(Leaf& leaf, const GuidingRecord& r);
-  void radix_sort_by_key(std::vector<GuidingRecord>& records, uint64_t max_key);
+  void radix_sort_by_key(std::vector<GuidingRecord>& records, int bits);
   void split(uint32_t node, std::vector<uint64_t>& counts);
   void split_leaves(int k);
   size_t leaf_bytes(const Leaf& l) const;

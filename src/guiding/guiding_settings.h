@@ -19,8 +19,8 @@ struct GuidingSettings {
   // under this many bytes; splits and refinements that would exceed it are not done.
   size_t max_bytes = size_t(32) << 20;
   // Filtered splatting (Müller 2019): each record is spread over a box the size of its spatial
-  // leaf (stochastically: a jittered position) and of its directional leaf (deterministically:
-  // by overlap area).
+  // leaf and of its directional leaf, both stochastically (a position jittered within the box;
+  // in expectation the box filter, see DirectionalQuadtree::record_jittered).
   bool filter = true;
   // The probability of sampling the BSDF rather than the learned distribution: learned per
   // spatial leaf by Adam on the KL divergence gradient (Müller 2019) when negative, else fixed.

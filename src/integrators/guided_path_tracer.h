@@ -19,7 +19,10 @@
 // hits with their MIS weight) over its density, and the next event sample's radiance times its
 // MIS weight over the light density, along the light's direction: together an MIS estimate of
 // the incident radiance's integral over each quadrant. Vertices whose estimate is zero are not
-// recorded (as Müller's implementation). Filtered splatting: guiding_settings.h.
+// recorded (as Müller's implementation), but every guided vertex counts for the split rule.
+// The selection probability learns from the path records only: its target is what direction
+// sampling itself contributes (indirect light and its MIS share of direct light), not what next
+// event estimation already samples well. Filtered splatting: guiding_settings.h.
 //
 // Russian roulette runs on the larger of the throughput and the throughput BSDF sampling alone
 // would have had (throughput roulette ends guided paths toward bright light for their small

@@ -1,7 +1,10 @@
-// The learned radiance field of path guiding (guiding/, after Müller et al. 2017): its
-// directional distribution is a density over the sphere whose samples follow it, trained on a
-// known radiance field it learns that field, and its memory stays under the cap. guided-pt's
-// furnace, agreement with pt and thread determinism come from the registry oracles.
+// The learned radiance field of path guiding (guiding/, after Müller et al. 2017 and Müller
+// 2019): its directional distribution is a density over the sphere whose samples follow it,
+// trained on a known radiance field it learns that field, its memory stays under the cap, its
+// filtered splats conserve energy and its training does not depend on the order of the records;
+// the learned selection probability follows the better technique, and passes combine by inverse
+// variance. guided-pt's furnace, agreement with pt and thread determinism come from the registry
+// oracles.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -21,9 +21,9 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
            "(default 0.01)");
   o.integer("--guiding-max-mb", &s->guiding_max_mb, 1, 65536,
             "Guiding: memory cap of the learned structure in MiB (default 32)");
-  o.number("--guiding-bsdf-fraction", &s->guiding.bsdf_fraction, 0, 1, false,
-           "Guiding: fixed probability of sampling the BSDF instead of the learned distribution "
-           "(default: learned per spatial leaf by Adam, Mueller 2019)");
+  o.number("--guiding-bsdf-fraction", &s->guiding.bsdf_fraction, 0, 1, true,
+           "Guiding: fixed probability in (0, 1] of sampling the BSDF instead of the learned "
+           "distribution (default: learned per spatial leaf by Adam, Mueller 2019)");
   o.choice("--guiding-filter", &s->guiding_filter, {"on", "off"},
            "Guiding: box-filtered splatting into the spatial and directional trees, on or off "
            "(default on)");

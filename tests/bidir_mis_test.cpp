@@ -359,7 +359,7 @@ TEST(BidirLightVertex, PackingRoundTrips) {
     v.depth = int(gen() % 200);
     v.throughput = Rgb(u(gen), u(gen), u(gen)) * std::ldexp(1.f, int(gen() % 60) - 30);
     v.mis = {std::ldexp(u(gen), int(gen() % 80) - 40), std::ldexp(u(gen), int(gen() % 80) - 40),
-             u(gen)};
+             u(gen), std::ldexp(u(gen), int(gen() % 80) - 40), v.depth == 1};
     const LightVertexData r = unpack_light_vertex(pack_light_vertex(v));
     EXPECT_EQ(r.p, v.p);                    // exact: merging must not depend on the scene's extent
     EXPECT_LT(length(r.wo - v.wo), 2e-4f);  // angle in radians, to first order
@@ -368,8 +368,11 @@ TEST(BidirLightVertex, PackingRoundTrips) {
     const float m = v.throughput.max_component();
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(r.throughput[c], v.throughput[c], m * 0x1p-16f);  // half a step of 16 bits
-    EXPECT_EQ(r.mis.vcm, v.mis.vcm);
-    EXPECT_EQ(r.mis.vc, v.mis.vc);
-    EXPECT_EQ(r.mis.vm, v.mis.vm);
+    // 24-bit floats: 16 significant bits, rounded.
+    EXPECT_NEAR(r.mis.vcm, v.mis.vcm, v.mis.vcm * 0x1p-16f);
+    EXPECT_NEAR(r.mis.rest, v.mis.rest, v.mis.rest * 0x1p-16f);
+    EXPECT_NEAR(r.mis.conn, v.mis.conn, v.mis.conn * 0x1p-16f);
+    EXPECT_NEAR(r.mis.merge, v.mis.merge, v.mis.merge * 0x1p-16f);
+    EXPECT_EQ(r.mis.first, v.depth == 1);
   }
 }

@@ -378,8 +378,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
         cs->raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
           const float w = tech_.unweighted
                               ? 1.f
-                              : bidir::weight_light_to_camera(it.rules, camera, si, bsdf, si.wo,
-                                                              mis, cs->p_lens, fs.pdf);
+                              : bidir::terms_light_to_camera(it.rules, camera, si, bsdf, si.wo, mis,
+                                                             cs->p_lens, fs.pdf)
+                                    .weight(it.rules.counts());
           const Rgb value = beta * f * (scale * w) * (fs.weight * fs.pdf);
           if (value.is_black()) return;
           if (!value.is_finite()) {
@@ -428,7 +429,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
     auto emitter_weight = [&](const Light& light, const SurfaceInteraction* hit, const MisSums& m) {
       if (depth == 0) return 1.f;
       if (!tech_.connect) return specular_path ? 1.f : 0.f;
-      return bidir::weight_emitter_hit(it.rules, light, lights.pmf(&light), prev_p, ray.d, hit, m);
+      return bidir::terms_emitter_hit(it.rules, light, lights.pmf(&light), prev_p, ray.d, hit, m)
+          .weight(it.rules.counts());
     };
 
     for (;;) {
@@ -495,7 +497,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
     const Vec2 u = rng.next_2d();
     const auto d = sample_direct_light(scene, si, bsdf, u_light, u);
     if (!d) return;
-    const float w = bidir::weight_next_event(it.rules, *d->light, d->pmf, d->ls, si, bsdf, mis);
+    const float w = bidir::terms_next_event(it.rules, *d->light, d->pmf, d->ls, si, bsdf, mis)
+                        .weight(it.rules.counts());
     const Rgb value = beta * d->f * d->ls.radiance * (w / (d->pmf * d->ls.pdf_w));
     if (value.is_black()) return;
     if (scene.occluded(d->shadow)) return;
@@ -524,7 +527,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
           light_bsdf.f(v.wo, -dir, TransportMode::Importance) * light_bsdf.abs_cos(dir);
       if (f_light.is_black()) continue;
       const float w =
-          bidir::weight_connection(it.rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf, mis);
+          bidir::terms_connection(it.rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf, mis)
+              .weight(it.rules.counts());
       const Rgb value = beta * v.throughput * f_camera * f_light * (w / dist2);
       if (value.is_black()) continue;
       if (scene.occluded(spawn_ray_between(si, light_si))) continue;
@@ -565,7 +569,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
           !photon_visible(scene, si, v.primitive, q, v.wo, it.radius))
         return;
       const float w =
-          tech_.unweighted ? 1.f : bidir::weight_merge(it.rules, v.wo, v.mis, si, bsdf, mis);
+          tech_.unweighted
+              ? 1.f
+              : bidir::terms_merge(it.rules, v.wo, v.mis, si, bsdf, mis).weight(it.rules.counts());
       acc.add(true, light_depth + 1, depth + 1,
               beta * f * v.throughput * (w * it.merge_normalization));
     });

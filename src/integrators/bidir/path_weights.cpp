@@ -12,10 +12,16 @@ namespace caustica::bidir {
 std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
                                                 MisHeuristic heuristic, float light_paths,
                                                 float radius, const ExplicitPath& path,
-                                                ScratchArena& arena, float raster_density) {
+                                                ScratchArena& arena, float raster_density,
+                                                int connections, bool pixel_merges) {
   const bool connect = algorithm != BidirAlgorithm::Bpm;
-  const bool merge = algorithm != BidirAlgorithm::Bpt;
-  const MisRules rules(heuristic, connect, merge, light_paths, radius);
+  const bool merge = algorithm != BidirAlgorithm::Bpt && pixel_merges;
+  MisCounts counts;
+  counts.emitter = connect ? 1.f : 0.f;
+  counts.light_trace = connect ? light_paths : 0.f;
+  counts.connect = connect ? float(connections) : 0.f;
+  counts.merge = merge ? kPi * radius * radius * light_paths : 0.f;
+  const MisRules rules(heuristic, counts);
   const Light& light = *path.light;
   const float pmf = scene.light_sampler().pmf(&light);
   const bool finite = !light.is_infinite();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -90,7 +91,7 @@ AdaptivePlan::AdaptivePlan(size_t pixels, bool measured_costs, bool probe_every_
     : pixels_(pixels),
       measured_(measured_costs),
       probe_all_(probe_every_iteration),
-      moments_(pixels * candidates().size(), 0.f),
+      moments_(pixels * kCandidates, 0.f),
       merge_mask_(pixels, 1) {
   chosen_.light_paths = pixels;  // full VCM until the first probe is priced
 }
@@ -113,23 +114,51 @@ IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
   return p;
 }
 
-void AdaptivePlan::record(size_t pixel, float value, const TechniqueTerms* terms,
-                          const MisCounts& counts, float radius) {
+void AdaptivePlan::begin_probe() { light_sums_.assign(pixels_ * kCandidates, 0.f); }
+
+void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* terms,
+                       const MisCounts& counts, float radius) const {
   if (!(value != 0.f) || !std::isfinite(value)) return;
-  const float f2 = value * value;
-  const std::vector<Candidate>& list = candidates();
-  float* m = &moments_[pixel * list.size()];
   if (!terms) {
-    for (size_t j = 0; j < list.size(); ++j) m[j] += f2;
+    for (size_t j = 0; j < kCandidates; ++j) sums.a[j] += value;
     return;
   }
-  const float q = terms->denominator(counts);
-  if (!(q > 0) || !std::isfinite(q)) return;
-  for (size_t j = 0; j < list.size(); ++j) {
-    const float q_candidate = terms->denominator(counts_of(list[j], pixels_, radius));
-    // No technique of the candidate makes this path: it would miss the energy (infinite cost).
-    m[j] += q_candidate > 0 ? f2 * (q / q_candidate) : std::numeric_limits<float>::infinity();
+  const float q = terms->denominator(counts), own = counts.of(terms->own);
+  if (!(q > 0) || !std::isfinite(q) || !(own > 0)) return;
+  const std::vector<Candidate>& list = candidates();
+  for (size_t j = 0; j < kCandidates; ++j) {
+    const MisCounts n = counts_of(list[j], pixels_, radius);
+    const float q_candidate = terms->denominator(n);
+    if (!(q_candidate > 0)) {
+      // No technique of the candidate makes this path: it would miss the energy.
+      sums.d[j] = std::numeric_limits<float>::infinity();
+      continue;
+    }
+    const float ratio = q / q_candidate;
+    const float g = value * ratio * (n.of(terms->own) / own);
+    sums.a[j] += g;
+    sums.d[j] += value * value * ratio - g * g;
   }
+}
+
+void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTerms* terms,
+                                   const MisCounts& counts, float radius) {
+  CandidateSums sums = pixel_start(pixel);
+  add(sums, value, terms, counts, radius);
+  std::copy(sums.a.begin(), sums.a.end(), light_sums_.begin() + pixel * kCandidates);
+  float* m = &moments_[pixel * kCandidates];
+  for (size_t j = 0; j < kCandidates; ++j) m[j] += sums.d[j];
+}
+
+AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
+  CandidateSums sums;
+  std::copy_n(light_sums_.begin() + pixel * kCandidates, kCandidates, sums.a.begin());
+  return sums;
+}
+
+void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums) {
+  float* m = &moments_[pixel * kCandidates];
+  for (size_t j = 0; j < kCandidates; ++j) m[j] += sums.a[j] * sums.a[j] + sums.d[j];
 }
 
 void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means) {

@@ -26,6 +26,7 @@
 // count unless measured costs are asked for; one process only (learns while rendering).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <vector>
@@ -63,11 +64,29 @@ class AdaptivePlan {
   bool is_probe(uint32_t iteration) const;
   IterationPlan plan(uint32_t iteration) const;
 
-  // A probe's contribution F (the pixel's estimate gets F) with its MIS terms, under `counts`
-  // (the probe's, balance heuristic). Each pixel is recorded by one task at a time.
-  // terms == nullptr: a path only one technique makes (every candidate keeps its F^2).
-  void record(size_t pixel, float value, const TechniqueTerms* terms, const MisCounts& counts,
-              float radius);
+  // Recording a probe. A pixel's estimate in a probe is the sum of its contributions F_i, each
+  // from a technique t_i of the probe's counts n. Under candidate counts n' the same path has
+  // the balance denominator Q'_i instead of Q_i. Per candidate the pixel keeps
+  //   A = sum G_i,  G_i = F_i (Q_i / Q'_i) (n'_t / n_t)  (mean-preserving: E[A] = the pixel value)
+  //   D = sum (F_i^2 Q_i / Q'_i - G_i^2)
+  // and A^2 + D estimates the candidate's second moment: its diagonal is the proxy correction
+  // sum F^2 Q / Q' (exact for independent samples), its cross terms those of the reweighted
+  // contributions, which share the camera path as the candidate's would. For the probe's own
+  // counts it is the sample's (sum F)^2. Light-tracing splats come first (add_light_trace, in a
+  // fixed order), then the pixel's task continues from pixel_start() with add() and hands the
+  // sums back with pixel_end().
+  static constexpr size_t kCandidates = 33;
+  struct CandidateSums {
+    std::array<float, kCandidates> a{}, d{};
+  };
+  void begin_probe();
+  // terms == nullptr: a path only one technique makes (the same F under every candidate).
+  void add(CandidateSums& sums, float value, const TechniqueTerms* terms, const MisCounts& counts,
+           float radius) const;
+  void add_light_trace(size_t pixel, float value, const TechniqueTerms* terms,
+                       const MisCounts& counts, float radius);
+  CandidateSums pixel_start(size_t pixel) const;
+  void pixel_end(size_t pixel, const CandidateSums& sums);
   // After a probe: its work, and the pixel means of the iterations before it (empty after the
   // first; a mean from the probes alone makes a single sample look noiseless); re-optimises.
   void finish_probe(const ProbeWork& work, const std::vector<float>& means);
@@ -88,7 +107,8 @@ class AdaptivePlan {
   size_t pixels_ = 0;
   bool measured_ = false;
   bool probe_all_ = false;
-  std::vector<float> moments_;  // pixels x candidates: sum over probes of F^2 Q / Q'
+  std::vector<float> moments_;     // pixels x candidates: sum over probes of A^2 + D
+  std::vector<float> light_sums_;  // pixels x candidates: this probe's light-tracing A
   int probes_ = 0;
   ProbeWork work_;  // summed over probes
   std::vector<uint8_t> merge_mask_;

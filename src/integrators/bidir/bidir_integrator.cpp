@@ -143,6 +143,7 @@ struct PixelAccumulator {
   float filter_weight = 1;  // the camera sample's pixel-filter weight (pixel_filter.h)
   // Probe iterations of adaptive-vcm: each contribution with its MIS terms, and the work.
   bidir::AdaptivePlan* plan = nullptr;
+  bidir::AdaptivePlan::CandidateSums candidate_sums;
   const MisRules* rules = nullptr;
   float radius = 0;
   bidir::ProbeWork work;
@@ -157,7 +158,8 @@ struct PixelAccumulator {
     sum += value;
     if (techniques)
       techniques->add(TechniqueImages::key(merge, s, t), pixel, value * filter_weight);
-    if (plan) plan->record(pixel, scalar(value * filter_weight), terms, rules->counts(), radius);
+    if (plan)
+      plan->add(candidate_sums, scalar(value * filter_weight), terms, rules->counts(), radius);
   }
 };
 
@@ -231,6 +233,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
                                                   iteration, settings_.seed);
     probe_ = {};
     probe_.light_paths = double(n);
+    if (it.plan.probe) plan_.begin_probe();
 
     const auto light_start = std::chrono::steady_clock::now();
     size_chunks(n);
@@ -363,8 +366,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
         splat_image_[s.pixel] += s.value;
         if (techniques_.enabled()) techniques_.add(s.technique, s.pixel, s.value);
         if (it.plan.probe)
-          plan_.record(s.pixel, scalar(s.value), &chunk.splat_terms[i], it.rules.counts(),
-                       it.radius);
+          plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[i], it.rules.counts(),
+                                it.radius);
       }
     }
     if (nonfinite) film.count_nonfinite(nonfinite);
@@ -491,11 +494,13 @@ class BidirIntegrator final : public CameraPathIntegrator {
     if (it.plan.probe) {
       acc.plan = &plan_;
       acc.radius = it.radius;
+      acc.candidate_sums = plan_.pixel_start(sample.pixel);
     }
     const auto start = std::chrono::steady_clock::now();
     camera_path(scene, it, sample, rng, acc, arena);
     *nonfinite += acc.nonfinite;
     if (it.plan.probe) {
+      plan_.pixel_end(sample.pixel, acc.candidate_sums);
       if (settings_.bidir.measured_costs) acc.work.camera_seconds = seconds_since(start);
       add_probe_work(acc.work);
     }

@@ -12,16 +12,17 @@
 namespace caustica::bidir {
 
 namespace {
-// The fixed cost model, in microseconds per operation, measured on the development machine
-// (2-core x86-64, Release) with measured costs on cornell-glass, door-ajar and water-caustic
-// (medians). Used whenever costs are not measured live, so that a render at fixed spp and seed
+// The fixed cost model, in microseconds per operation: medians of what --adaptive-costs measured
+// reports on the development machine (2-core x86-64, g++ 12 Release, 1 thread, 2026-11-30) on
+// door-ajar, mis-plates, water-caustic and cornell-box (light vertices ranged 0.85-2.3 us with
+// the scene). Used whenever costs are not measured live, so that a render at fixed spp and seed
 // chooses the same configurations on every machine and for every thread count.
 struct CostModel {
-  double camera_vertex = 1.0;  // trace, BSDF, NEE with its shadow ray
-  double light_vertex = 1.2;   // trace, BSDF, store, connect to the lens
-  double connection = 0.35;    // one light vertex connected to one camera vertex
-  double merge_query = 0.15;   // one range query
-  double photon = 0.03;        // one photon gathered
+  double camera_vertex = 0.8;  // trace, BSDF, NEE with its shadow ray
+  double light_vertex = 1.3;   // trace, BSDF, store, connect to the lens
+  double connection = 0.8;     // one light vertex connected to one camera vertex
+  double merge_query = 0.3;    // one range query
+  double photon = 0.06;        // one photon gathered
 };
 constexpr float kLightPathFactors[] = {0.25f, 0.5f, 1.f, 2.f};
 constexpr int kConnections[] = {0, 1, 2, 4};
@@ -87,13 +88,15 @@ const std::vector<AdaptivePlan::Candidate>& AdaptivePlan::candidates() {
   return list;
 }
 
-AdaptivePlan::AdaptivePlan(size_t pixels, bool measured_costs, bool probe_every_iteration)
-    : pixels_(pixels),
+AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool probe_every_iteration)
+    : pixels_(size_t(width) * size_t(height)),
+      width_(width),
+      height_(height),
       measured_(measured_costs),
       probe_all_(probe_every_iteration),
-      moments_(pixels * kCandidates, 0.f),
-      merge_mask_(pixels, 1) {
-  chosen_.light_paths = pixels;  // full VCM until the first probe is priced
+      moments_(pixels_ * kCandidates, 0.f),
+      merge_mask_(pixels_, 1) {
+  chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
 }
 
 bool AdaptivePlan::is_probe(uint32_t iteration) const {
@@ -257,6 +260,18 @@ void AdaptivePlan::report(nlohmann::json& stats) const {
       pixels_ ? double(std::count(merge_mask_.begin(), merge_mask_.end(), 1)) / double(pixels_)
               : 0.0;
   a["history"] = history_;
+  // The merge mask, block-averaged to at most 64 x 64 cells.
+  const int block = std::max(1, (std::max(width_, height_) + 63) / 64);
+  const int cw = (width_ + block - 1) / block, ch = (height_ + block - 1) / block;
+  std::vector<double> fraction(size_t(cw) * ch, 0.0), count(size_t(cw) * ch, 0.0);
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) {
+      const size_t cell = size_t(y / block) * cw + size_t(x / block);
+      fraction[cell] += merge_mask_[size_t(y) * width_ + x];
+      count[cell] += 1;
+    }
+  for (size_t i = 0; i < fraction.size(); ++i) fraction[i] /= std::max(count[i], 1.0);
+  a["merge_mask"] = {{"width", cw}, {"height", ch}, {"block", block}, {"fraction", fraction}};
   stats["adaptive"] = a;
 }
 

@@ -59,7 +59,7 @@ struct ProbeWork {
 class AdaptivePlan {
  public:
   AdaptivePlan() = default;
-  AdaptivePlan(size_t pixels, bool measured_costs, bool probe_every_iteration = false);
+  AdaptivePlan(int width, int height, bool measured_costs, bool probe_every_iteration = false);
 
   bool is_probe(uint32_t iteration) const;
   IterationPlan plan(uint32_t iteration) const;
@@ -91,6 +91,9 @@ class AdaptivePlan {
   // first; a mean from the probes alone makes a single sample look noiseless); re-optimises.
   void finish_probe(const ProbeWork& work, const std::vector<float>& means);
 
+  // "adaptive": the configuration, the history of choices (each with its candidate table and
+  // costs) and the merge mask as the fraction of merging pixels in blocks of at most 64 x 64
+  // cells ("merge_mask": width, height, row-major "fraction").
   void report(nlohmann::json& stats) const;
   const std::vector<uint8_t>& merge_mask() const { return merge_mask_; }
 
@@ -105,6 +108,7 @@ class AdaptivePlan {
   void choose(const std::vector<float>& means);
 
   size_t pixels_ = 0;
+  int width_ = 0, height_ = 0;
   bool measured_ = false;
   bool probe_all_ = false;
   std::vector<float> moments_;     // pixels x candidates: sum over probes of A^2 + D

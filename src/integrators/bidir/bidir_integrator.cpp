@@ -201,7 +201,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
         settings_.bidir.light_paths > 0 ? settings_.bidir.light_paths : film.pixel_count();
     if (!settings_.bidir.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
     if (tech_.adaptive)
-      plan_ = bidir::AdaptivePlan(film.pixel_count(), settings_.bidir.measured_costs,
+      plan_ = bidir::AdaptivePlan(film.width(), film.height(), settings_.bidir.measured_costs,
                                   settings_.bidir.probe_every_iteration);
   }
 

@@ -26,7 +26,9 @@ struct CostModel {
 };
 constexpr float kLightPathFactors[] = {0.25f, 0.5f, 1.f, 2.f};
 constexpr int kConnections[] = {0, 1, 2, 4};
-constexpr double kRelEps = 0.01;  // as the relMSE metric (image/metrics.h)
+constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
+constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
+constexpr int kFirstProbes = 4;
 
 // The operation costs: the model, or what the probes measured (seconds summed over threads).
 CostModel costs_of(const ProbeWork& w, bool measured) {
@@ -100,7 +102,8 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
 }
 
 bool AdaptivePlan::is_probe(uint32_t iteration) const {
-  return probe_all_ || std::has_single_bit(uint64_t(iteration) + 1);  // 0, 1, 3, 7, 15, ...
+  // 0, 1, 2, 3, then 7, 15, 31, ...
+  return probe_all_ || iteration < kFirstProbes || std::has_single_bit(uint64_t(iteration) + 1);
 }
 
 IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
@@ -177,7 +180,27 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   work_.camera_seconds += w.camera_seconds;
   work_.connect_seconds += w.connect_seconds;
   work_.merge_seconds += w.merge_seconds;
-  if (means.size() == pixels_) choose(means);
+  // A choice needs the film's means and a few probes: one or two are mostly noise.
+  if (means.size() == pixels_ && (probes_ >= kFirstProbes || probe_all_)) choose(means);
+}
+
+std::vector<double> AdaptivePlan::relative_variances(size_t j,
+                                                     const std::vector<float>& means) const {
+  const double probes = double(probes_);
+  std::vector<double> v(pixels_);
+  for (size_t p = 0; p < pixels_; ++p) {
+    const double mean = means[p], moment = moments_[p * kCandidates + j] / probes;
+    v[p] = std::max(moment - mean * mean, 0.0) / (mean * mean + kRelEps);
+  }
+  // Winsorised at the 99.5th percentile: a firefly that a few probes saw in a handful of pixels
+  // (and that every candidate shares) is mostly estimation noise; at full weight it drowns the
+  // differences everywhere else and lets the cheapest candidate win.
+  std::vector<double> sorted = v;
+  const size_t q = std::min(pixels_ - 1, size_t(double(pixels_) * kWinsorize));
+  std::nth_element(sorted.begin(), sorted.begin() + q, sorted.end());
+  const double cap = sorted[q];
+  for (double& x : v) x = std::min(x, cap);
+  return v;
 }
 
 void AdaptivePlan::choose(const std::vector<float>& means) {
@@ -189,12 +212,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
                      work_.light_paths > 0 ? work_.light_vertices / work_.light_paths : 0.0,
                      work_.merge_queries / (probes * pixels), work_.photons / (probes * pixels)};
   const CostModel t = costs_of(work_, measured_);
-  // Relative variance of pixel p under candidate j.
-  auto rel_var = [&](size_t p, size_t j) {
-    const double mean = means[p];
-    const double moment = moments_[p * k + j] / probes;
-    return std::max(moment - mean * mean, 0.0) / (mean * mean + kRelEps);
-  };
+  const std::vector<double> pt = relative_variances(0, means);
   double best = std::numeric_limits<double>::infinity();
   size_t best_j = 0;
   std::vector<uint8_t> mask(pixels_), best_mask(pixels_, 0);
@@ -204,10 +222,11 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     const Candidate& c = list[j];
     const double cost = base_cost(c, pw, t);
     const double extra = j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t);
+    const std::vector<double> no_merge = j == 0 ? pt : relative_variances(j, means);
+    const std::vector<double> merge = j == 0 ? pt : relative_variances(j + 1, means);
     double variance = 0, total_cost = 0, variance0 = 0, variance1 = 0;
     for (size_t p = 0; p < pixels_; ++p) {
-      const double v0 = rel_var(p, j);
-      const double v1 = j == 0 ? v0 : rel_var(p, j + 1);
+      const double v0 = no_merge[p], v1 = merge[p];
       variance0 += v0;
       variance1 += v1;
       mask[p] = j != 0 && v1 * (cost + extra) < v0 * cost;

@@ -20,7 +20,9 @@
 // (light paths, connections) the merge mask takes, per pixel, the option of lower
 // variance x (pixel cost); then the global pair of lowest total wins.
 //
-// Probes are iterations 0, 1, 3, 7, 15, ... (2^k - 1): their cost fades as the render grows.
+// Probes are iterations 0 to 3, then 7, 15, 31, ... (2^k - 1): their cost fades as the render
+// grows. The first choice is made after the fourth probe; the pixels' relative variances are
+// winsorised at their 99.5th percentile (a firefly all candidates share must not decide).
 // Every iteration, probe or not, is an unbiased (consistent, when merging) estimate of the
 // same image, and the film averages them. Deterministic at fixed spp and seed for any thread
 // count unless measured costs are asked for; one process only (learns while rendering).
@@ -105,6 +107,8 @@ class AdaptivePlan {
   static const std::vector<Candidate>& candidates();
 
  private:
+  // Per pixel: the relative variance per iteration of candidate j, winsorised.
+  std::vector<double> relative_variances(size_t j, const std::vector<float>& means) const;
   void choose(const std::vector<float>& means);
 
   size_t pixels_ = 0;

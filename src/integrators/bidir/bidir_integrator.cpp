@@ -1,6 +1,8 @@
 #include "integrators/bidir/bidir_integrator.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include <array>
 #include <atomic>
@@ -104,6 +106,7 @@ struct Splat {
 
 // What one chunk of light paths leaves behind.
 struct LightChunk {
+  uint64_t first_path = 0;
   std::vector<LightVertex> vertices;
   std::vector<uint32_t> path_ends;  // per path: vertices.size() after it
   std::vector<Splat> splats;
@@ -173,8 +176,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
         settings_.bidir.light_paths > 0 ? settings_.bidir.light_paths : film.pixel_count();
     if (!settings_.bidir.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
     chunk_paths_ = chunk_paths_for(light_paths_);
-    chunks_.resize((light_paths_ + chunk_paths_ - 1) / chunk_paths_);
-    chunk_offset_.resize(chunks_.size());
+    chunk_count_ = (light_paths_ + chunk_paths_ - 1) / chunk_paths_;
   }
 
   void render_iteration(const Scene& scene, uint32_t iteration, Film& film) override {
@@ -237,56 +239,91 @@ class BidirIntegrator final : public CameraPathIntegrator {
   bool stores_vertices() const { return tech_.connect || tech_.merge; }
 
   // ---- light subpaths -----------------------------------------------------------------------
+  // Chunks are traced in parallel into a few reused buffers and appended, in chunk order, to
+  // vertices_ and the splat image as they finish (a pipeline whose last stage is serial and in
+  // order): no chunk is kept once appended, so the vertices are held once, not per chunk and
+  // again concatenated, and the result is the concatenation in path order for any threads.
   void trace_light_paths(const Scene& scene, const Iteration& it, Film& film) {
-    tbb::parallel_for(size_t(0), chunks_.size(), [&](size_t c) {
-      thread_local ScratchArena arena;
-      LightChunk& chunk = chunks_[c];
-      chunk.vertices.clear();
-      chunk.path_ends.clear();
-      chunk.splats.clear();
-      chunk.nonfinite = 0;
-      const uint64_t first = c * chunk_paths_,
-                     last = std::min<uint64_t>(first + chunk_paths_, light_paths_);
-      for (uint64_t path = first; path < last; ++path) {
-        arena.reset();
-        trace_light_path(scene, it, path, chunk, arena);
-        chunk.path_ends.push_back(uint32_t(chunk.vertices.size()));
-      }
-    });
-
-    // Concatenate in chunk order: vertex i of path p is at path_begin_[p] + i.
-    size_t total = 0;
-    for (const LightChunk& c : chunks_) total += c.vertices.size();
-    vertices_.resize(total);
+    vertices_.clear();
     path_begin_.resize(light_paths_ + 1);
-    std::vector<size_t>& chunk_offset = chunk_offset_;
-    for (size_t c = 0, offset = 0; c < chunks_.size(); ++c) {
-      chunk_offset[c] = offset;
-      offset += chunks_[c].vertices.size();
+    if (tech_.light_to_camera) {
+      if (splat_image_.width() != film.width()) splat_image_ = Image(film.width(), film.height());
+      std::fill(splat_image_.pixels().begin(), splat_image_.pixels().end(), Rgb(0.f));
     }
-    tbb::parallel_for(size_t(0), chunks_.size(), [&](size_t c) {
-      const LightChunk& chunk = chunks_[c];
-      std::copy(chunk.vertices.begin(), chunk.vertices.end(), vertices_.begin() + chunk_offset[c]);
-      const uint64_t first = c * chunk_paths_;
-      for (size_t i = 0; i < chunk.path_ends.size(); ++i) {
-        path_begin_[first + i] = uint32_t(chunk_offset[c] + (i ? chunk.path_ends[i - 1] : 0));
-      }
-    });
-    path_begin_[light_paths_] = uint32_t(total);
-
+    const size_t tokens = std::min<size_t>(
+        chunk_count_, 4 * size_t(std::max(1, tbb::this_task_arena::max_concurrency())));
+    if (chunk_buffers_.size() < tokens) chunk_buffers_.resize(tokens);
+    std::vector<LightChunk*> free_buffers;
+    for (size_t i = 0; i < tokens; ++i) free_buffers.push_back(&chunk_buffers_[i]);
+    std::mutex free_mutex;
+    uint64_t next_chunk = 0, nonfinite = 0;
+    tbb::parallel_pipeline(tokens,
+                           tbb::make_filter<void, uint64_t>(tbb::filter_mode::serial_in_order,
+                                                            [&](tbb::flow_control& fc) -> uint64_t {
+                                                              if (next_chunk == chunk_count_)
+                                                                fc.stop();
+                                                              return next_chunk++;
+                                                            }) &
+                               tbb::make_filter<uint64_t, LightChunk*>(
+                                   tbb::filter_mode::parallel,
+                                   [&](uint64_t c) {
+                                     LightChunk* chunk;
+                                     {
+                                       const std::lock_guard<std::mutex> lock(free_mutex);
+                                       chunk = free_buffers.back();
+                                       free_buffers.pop_back();
+                                     }
+                                     trace_chunk(scene, it, c, *chunk);
+                                     return chunk;
+                                   }) &
+                               tbb::make_filter<LightChunk*, void>(
+                                   tbb::filter_mode::serial_in_order, [&](LightChunk* chunk) {
+                                     append_chunk(*chunk);
+                                     nonfinite += chunk->nonfinite;
+                                     const std::lock_guard<std::mutex> lock(free_mutex);
+                                     free_buffers.push_back(chunk);
+                                   }));
+    path_begin_[light_paths_] = uint32_t(vertices_.size());
     if (!tech_.light_to_camera) return;
-    if (splat_image_.width() != film.width()) splat_image_ = Image(film.width(), film.height());
-    std::fill(splat_image_.pixels().begin(), splat_image_.pixels().end(), Rgb(0.f));
-    uint64_t nonfinite = 0;
-    for (const LightChunk& chunk : chunks_) {  // fixed order: deterministic sums
-      nonfinite += chunk.nonfinite;
-      for (const Splat& s : chunk.splats) {
-        splat_image_[s.pixel] += s.value;
-        if (techniques_.enabled()) techniques_.add(s.technique, s.pixel, s.value);
-      }
-    }
     if (nonfinite) film.count_nonfinite(nonfinite);
     film.add_image(splat_image_);
+  }
+
+  // Light paths [first, last) of chunk c, traced into chunk (its storage reused).
+  void trace_chunk(const Scene& scene, const Iteration& it, uint64_t c, LightChunk& chunk) const {
+    thread_local ScratchArena arena;
+    chunk.vertices.clear();
+    chunk.path_ends.clear();
+    chunk.splats.clear();
+    chunk.nonfinite = 0;
+    chunk.first_path = c * chunk_paths_;
+    const uint64_t last = std::min<uint64_t>(chunk.first_path + chunk_paths_, light_paths_);
+    for (uint64_t path = chunk.first_path; path < last; ++path) {
+      arena.reset();
+      trace_light_path(scene, it, path, chunk, arena);
+      chunk.path_ends.push_back(uint32_t(chunk.vertices.size()));
+    }
+  }
+
+  // The next chunk in path order: vertex i of path p lands at path_begin_[p] + i; its splats
+  // are added in the order they were made (deterministic sums).
+  void append_chunk(const LightChunk& chunk) {
+    const size_t need = vertices_.size() + chunk.vertices.size();
+    if (need > vertices_.capacity()) {
+      // Grow to what the chunks so far predict for the whole iteration, plus a tenth, rather
+      // than by doubling: this is the largest buffer, kept from one iteration to the next.
+      const uint64_t chunks_done = chunk.first_path / chunk_paths_ + 1;
+      const size_t predicted = size_t(double(need) * double(chunk_count_) / double(chunks_done));
+      vertices_.reserve(std::max(need, predicted + predicted / 10));
+    }
+    const uint32_t base = uint32_t(vertices_.size());
+    vertices_.insert(vertices_.end(), chunk.vertices.begin(), chunk.vertices.end());
+    for (size_t i = 0; i < chunk.path_ends.size(); ++i)
+      path_begin_[chunk.first_path + i] = base + (i ? chunk.path_ends[i - 1] : 0);
+    for (const Splat& s : chunk.splats) {
+      splat_image_[s.pixel] += s.value;
+      if (techniques_.enabled()) techniques_.add(s.technique, s.pixel, s.value);
+    }
   }
 
   void trace_light_path(const Scene& scene, const Iteration& it, uint64_t path, LightChunk& chunk,
@@ -600,8 +637,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
   // Per-iteration buffers, reused.
   uint64_t chunk_paths_ = kMaxChunkPaths;  // light paths per chunk (chunk_paths_for)
-  std::vector<LightChunk> chunks_;
-  std::vector<size_t> chunk_offset_;  // per chunk: its first vertex in vertices_
+  uint64_t chunk_count_ = 0;
+  std::vector<LightChunk> chunk_buffers_;  // one per chunk in flight (trace_light_paths)
   std::vector<LightVertex> vertices_;
   std::vector<uint32_t> path_begin_;
   HashGrid grid_;

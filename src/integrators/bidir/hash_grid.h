@@ -70,7 +70,7 @@ class HashGrid {
   }
 
   size_t memory_bytes() const {
-    return (cell_start_.capacity() + cells_.capacity() + fill_.capacity()) * sizeof(uint32_t) +
+    return (cell_start_.capacity() + cells_.capacity()) * sizeof(uint32_t) +
            entries_.capacity() * sizeof(Entry);
   }
 
@@ -103,7 +103,6 @@ class HashGrid {
   std::vector<Entry> entries_;        // sorted by bucket, in vertex order within one
   // Build scratch, kept so that a build allocates nothing once the sizes have been reached.
   std::vector<uint32_t> cells_;  // per vertex: its bucket
-  std::vector<uint32_t> fill_;   // per bucket: next free slot
 };
 
 }  // namespace caustica::bidir

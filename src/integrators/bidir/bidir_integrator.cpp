@@ -231,6 +231,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
     b["radius_last"] = last_radius_;
     b["radius_alpha"] = settings_.bidir.radius_alpha;
     b["ms_per_iteration"] = iterations_ ? 1e3 * seconds_total_ / iterations_ : 0.0;
+    b["light_paths_ms_per_iteration"] =
+        iterations_ ? 1e3 * light_seconds_total_ / iterations_ : 0.0;
     if (!technique_files_.empty()) b["technique_images"] = technique_files_;
     stats["bidir"] = b;
   }
@@ -244,6 +246,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
   // order): no chunk is kept once appended, so the vertices are held once, not per chunk and
   // again concatenated, and the result is the concatenation in path order for any threads.
   void trace_light_paths(const Scene& scene, const Iteration& it, Film& film) {
+    const auto start = std::chrono::steady_clock::now();
     vertices_.clear();
     path_begin_.resize(light_paths_ + 1);
     if (tech_.light_to_camera) {
@@ -284,9 +287,12 @@ class BidirIntegrator final : public CameraPathIntegrator {
                                      free_buffers.push_back(chunk);
                                    }));
     path_begin_[light_paths_] = uint32_t(vertices_.size());
-    if (!tech_.light_to_camera) return;
-    if (nonfinite) film.count_nonfinite(nonfinite);
-    film.add_image(splat_image_);
+    if (tech_.light_to_camera) {
+      if (nonfinite) film.count_nonfinite(nonfinite);
+      film.add_image(splat_image_);
+    }
+    light_seconds_total_ +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
   // Light paths [first, last) of chunk c, traced into chunk (its storage reused).
@@ -650,7 +656,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
   uint32_t iterations_ = 0;
   uint64_t vertices_total_ = 0;
   double seconds_total_ = 0;
-  double grid_seconds_total_ = 0;  // of seconds_total_, building the hash grid
+  double grid_seconds_total_ = 0;   // of seconds_total_, building the hash grid
+  double light_seconds_total_ = 0;  // of seconds_total_, tracing light paths (with their splats)
   std::vector<std::string> technique_files_;
 };
 

@@ -35,21 +35,23 @@ void HashGrid::build(const std::vector<LightVertex>& vertices, float radius, uin
   resize_for_rebuild(entries_, vertices.size());
   if (vertices.empty()) return;
 
-  // The bounds and each vertex's bucket in parallel (min / max and a per-vertex value: the
+  // The lower bound and each vertex's bucket in parallel (a minimum and a per-vertex value: the
   // same for any thread count); the counting sort after it stays serial, in vertex order.
   constexpr size_t kGrain = 16384;
   const tbb::blocked_range<size_t> all(0, vertices.size(), kGrain);
-  const Bounds3 box = tbb::parallel_reduce(
-      all, Bounds3(),
-      [&](const tbb::blocked_range<size_t>& r, Bounds3 b) {
-        for (size_t i = r.begin(); i < r.end(); ++i) b.extend(vertices[i].p());
-        return b;
+  // Only the lower corner is needed. Plain comparisons, not Bounds3's std::fmin (a libm call
+  // per coordinate that was a third of the build; positions are finite, so the result is the
+  // same).
+  auto lower = [](Vec3 a, Vec3 b) {
+    return Vec3(b.x < a.x ? b.x : a.x, b.y < a.y ? b.y : a.y, b.z < a.z ? b.z : a.z);
+  };
+  lo_ = tbb::parallel_reduce(
+      all, Vec3(kInfinity, kInfinity, kInfinity),
+      [&](const tbb::blocked_range<size_t>& r, Vec3 lo) {
+        for (size_t i = r.begin(); i < r.end(); ++i) lo = lower(lo, vertices[i].p());
+        return lo;
       },
-      [](Bounds3 a, const Bounds3& b) {
-        a.extend(b);
-        return a;
-      });
-  lo_ = box.lo;
+      lower);
   resize_for_rebuild(cells_, vertices.size());
   tbb::parallel_for(all, [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); ++i) cells_[i] = cell_of(vertices[i].p());

@@ -22,7 +22,8 @@ struct SceneSetup {
   std::string mis;  // "", "balance" or "power"; empty: each integrator's default
   // Integrator options (every rendering subcommand takes them; integrators that do not use one
   // ignore it).
-  BidirSettings bidir;  // --light-paths, --radius, --radius-alpha, --techniques
+  BidirSettings bidir;  // --light-paths, --radius, --radius-alpha, --techniques, --connections
+  std::string adaptive_costs;  // --adaptive-costs: "", "model" or "measured"
 };
 
 // The options render, reference and compare share, with the ranges they all obey.

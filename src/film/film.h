@@ -59,7 +59,8 @@ class Film {
   uint32_t iterations() const { return iterations_; }
   uint64_t nonfinite_count() const { return nonfinite_.load(); }
 
-  // Average over completed iterations.
+  // Average over completed iterations. Between iterations only: an iteration's estimates are
+  // in the totals as soon as they are added, before end_iteration() counts it.
   Image image() const;
 
   // Adds another film's completed iterations (same size): the result is bit-identical to a

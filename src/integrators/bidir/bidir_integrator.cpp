@@ -18,6 +18,7 @@
 #include "film/film.h"
 #include "film/pixel_filter.h"
 #include "image/image_io.h"
+#include "integrators/bidir/adaptive_plan.h"
 #include "integrators/bidir/hash_grid.h"
 #include "integrators/bidir/light_path_assignment.h"
 #include "integrators/bidir/light_vertex.h"
@@ -34,6 +35,7 @@ namespace caustica {
 
 namespace {
 
+using Clock = std::chrono::steady_clock;
 using bidir::HashGrid;
 using bidir::LightVertex;
 using bidir::LightVertexData;
@@ -58,6 +60,7 @@ struct Techniques {
   bool merge = false;            // vertex merging
   bool camera_stops = false;     // camera subpaths end at their first non-delta vertex
   bool unweighted = false;       // single-technique estimators (lt, ppm): all weights 1
+  bool adaptive = false;         // configuration chosen per iteration (adaptive_plan.h)
 };
 
 Techniques techniques_of(BidirAlgorithm a) {
@@ -78,6 +81,9 @@ Techniques techniques_of(BidirAlgorithm a) {
     case BidirAlgorithm::Vcm:
       t.light_to_camera = t.connect = t.merge = true;
       break;
+    case BidirAlgorithm::AdaptiveVcm:
+      t.light_to_camera = t.connect = t.merge = t.adaptive = true;
+      break;
   }
   return t;
 }
@@ -94,6 +100,8 @@ const char* name_of(BidirAlgorithm a) {
       return "bpm";
     case BidirAlgorithm::Vcm:
       return "vcm";
+    case BidirAlgorithm::AdaptiveVcm:
+      return "adaptive-vcm";
   }
   return "?";
 }
@@ -104,20 +112,27 @@ struct Splat {
   Rgb value;
 };
 
+// Scalar of a contribution for the adaptive plan's moments.
+float scalar(Rgb v) { return (v.r + v.g + v.b) * (1.f / 3.f); }
+
 // What one chunk of light paths leaves behind.
 struct LightChunk {
   uint64_t first_path = 0;
   std::vector<LightVertex> vertices;
   std::vector<uint32_t> path_ends;  // per path: vertices.size() after it
   std::vector<Splat> splats;
+  std::vector<bidir::TechniqueTerms> splat_terms;  // probe iterations: each splat's MIS terms
   uint64_t nonfinite = 0;
+  double seconds = 0;  // probe iterations: time spent tracing the chunk
 };
 
 // Per-iteration constants.
 struct Iteration {
   uint32_t index = 0;
+  bidir::IterationPlan plan;  // light paths, connections, merging
   float radius = 0;
   MisRules rules{MisHeuristic::Balance, false, false, 1, 0};
+  MisRules rules_no_merge = rules;           // in pixels that do not merge (adaptive-vcm)
   float merge_normalization = 0;             // 1 / (N pi r^2)
   bidir::LightPathAssignment light_path_of;  // pixel -> the light subpath it connects to
 };
@@ -129,9 +144,16 @@ struct PixelAccumulator {
   size_t pixel = 0;
   uint64_t nonfinite = 0;
   float filter_weight = 1;  // the camera sample's pixel-filter weight (pixel_filter.h)
+  // Probe iterations of adaptive-vcm: each contribution with its MIS terms, and the work.
+  bidir::AdaptivePlan* plan = nullptr;
+  bidir::AdaptivePlan::CandidateSums candidate_sums;
+  const MisRules* rules = nullptr;
+  float radius = 0;
+  bidir::ProbeWork work;
   // sum is the estimate before the filter weight (the seam applies it); technique images get
-  // each value already weighted, so that they add up to the image.
-  void add(bool merge, int s, int t, Rgb value) {
+  // each value already weighted, so that they add up to the image. terms: the value's MIS
+  // terms (nullptr: a path only one technique makes).
+  void add(bool merge, int s, int t, Rgb value, const bidir::TechniqueTerms* terms = nullptr) {
     if (!value.is_finite()) {
       ++nonfinite;
       return;
@@ -139,8 +161,14 @@ struct PixelAccumulator {
     sum += value;
     if (techniques)
       techniques->add(TechniqueImages::key(merge, s, t), pixel, value * filter_weight);
+    if (plan)
+      plan->add(candidate_sums, scalar(value * filter_weight), terms, rules->counts(), radius);
   }
 };
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
 Ray ray_leaving_light(const LightLeSample& le, const Light& light) {
   if (light.type() == LightType::Area) {
@@ -175,8 +203,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
     light_paths_ =
         settings_.bidir.light_paths > 0 ? settings_.bidir.light_paths : film.pixel_count();
     if (!settings_.bidir.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
-    chunk_paths_ = chunk_paths_for(light_paths_);
-    chunk_count_ = (light_paths_ + chunk_paths_ - 1) / chunk_paths_;
+    if (tech_.adaptive)
+      plan_ = bidir::AdaptivePlan(film.width(), film.height(), settings_.bidir.measured_costs,
+                                  settings_.bidir.probe_every_iteration);
   }
 
   void render_iteration(const Scene& scene, uint32_t iteration, Film& film) override {
@@ -187,21 +216,56 @@ class BidirIntegrator final : public CameraPathIntegrator {
     it.radius = std::max(
         base_radius_ * std::pow(float(iteration + 1), 0.5f * (settings_.bidir.radius_alpha - 1.f)),
         1e-7f);
-    it.rules = MisRules(heuristic_, tech_.connect || tech_.light_to_camera, tech_.merge,
-                        float(light_paths_), it.radius);
-    it.merge_normalization = 1.f / (kPi * it.radius * it.radius * float(light_paths_));
-    it.light_path_of =
-        bidir::LightPathAssignment(film.pixel_count(), light_paths_, iteration, settings_.seed);
+    if (tech_.adaptive) {
+      it.plan = plan_.plan(iteration);
+    } else {
+      it.plan.light_paths = light_paths_;
+      it.plan.connections = settings_.bidir.connections;
+    }
+    const uint64_t n = it.plan.light_paths;
+    bidir::MisCounts counts;
+    const bool connect = tech_.connect || tech_.light_to_camera;
+    counts.emitter = connect ? 1.f : 0.f;
+    counts.light_trace = connect ? float(n) : 0.f;
+    counts.connect = connect && n > 0 ? float(it.plan.connections) : 0.f;
+    counts.merge = tech_.merge ? kPi * it.radius * it.radius * float(n) : 0.f;
+    it.rules = MisRules(heuristic_, counts);
+    it.rules_no_merge = it.rules.with_merging(false);
+    it.merge_normalization = n ? 1.f / (kPi * it.radius * it.radius * float(n)) : 0.f;
+    it.light_path_of = bidir::LightPathAssignment(film.pixel_count(), std::max<uint64_t>(n, 1),
+                                                  iteration, settings_.seed);
+    probe_ = {};
+    probe_.light_paths = double(n);
+    if (it.plan.probe) plan_.begin_probe();
+    // Before this iteration adds anything: the film adds estimates to its totals as they come.
+    const std::vector<float> means_before =
+        it.plan.probe ? pixel_means(film) : std::vector<float>();
 
+    const auto light_start = std::chrono::steady_clock::now();
+    size_chunks(n);
     trace_light_paths(scene, it, film);
-    if (tech_.merge) {
+    const double light_seconds = seconds_since(light_start);
+    const bool any_merge = tech_.merge && n > 0 &&
+                           (it.plan.merge_everywhere ||
+                            std::find(it.plan.merge_mask->begin(), it.plan.merge_mask->end(), 1) !=
+                                it.plan.merge_mask->end());
+    if (any_merge) {
       const auto grid_start = std::chrono::steady_clock::now();
       grid_.build(vertices_, it.radius);
       grid_seconds_total_ +=
           std::chrono::duration<double>(std::chrono::steady_clock::now() - grid_start).count();
     }
     current_ = it;
+    const auto camera_start = std::chrono::steady_clock::now();
     trace_camera_paths(scene, iteration, film);
+    if (it.plan.probe) {
+      probe_.light_vertices = double(vertices_.size());
+      probe_.light_seconds = 0;
+      probe_.light_seconds = light_chunk_seconds_;
+      if (probe_.light_seconds == 0) probe_.light_seconds = light_seconds;
+      if (probe_.camera_seconds == 0) probe_.camera_seconds = seconds_since(camera_start);
+      plan_.finish_probe(probe_, means_before);
+    }
 
     ++iterations_;
     last_radius_ = it.radius;
@@ -216,6 +280,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
   }
 
   void report(nlohmann::json& stats) const override {
+    if (tech_.adaptive) plan_.report(stats);
     nlohmann::json b;
     b["algorithm"] = name();
     b["mis"] = heuristic_ == MisHeuristic::Power ? "power" : "balance";
@@ -240,6 +305,22 @@ class BidirIntegrator final : public CameraPathIntegrator {
  private:
   bool stores_vertices() const { return tech_.connect || tech_.merge; }
 
+  // Scalar pixel means of the film's completed iterations (empty before the first); between
+  // iterations only (film.h).
+  static std::vector<float> pixel_means(const Film& film) {
+    if (film.iterations() == 0) return {};
+    const Image image = film.image();
+    std::vector<float> means(image.pixels().size());
+    for (size_t p = 0; p < means.size(); ++p) means[p] = scalar(image.pixels()[p]);
+    return means;
+  }
+
+  // Chunks for n light paths (chunk_paths_for).
+  void size_chunks(uint64_t n) {
+    chunk_paths_ = chunk_paths_for(std::max<uint64_t>(n, 1));
+    chunk_count_ = n ? (n + chunk_paths_ - 1) / chunk_paths_ : 0;
+  }
+
   // ---- light subpaths -----------------------------------------------------------------------
   // Chunks are traced in parallel into a few reused buffers and appended, in chunk order, to
   // vertices_ and the splat image as they finish (a pipeline whose last stage is serial and in
@@ -248,7 +329,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
   void trace_light_paths(const Scene& scene, const Iteration& it, Film& film) {
     const auto start = std::chrono::steady_clock::now();
     vertices_.clear();
-    path_begin_.resize(light_paths_ + 1);
+    path_begin_.resize(it.plan.light_paths + 1);
+    light_chunk_seconds_ = 0;
     if (tech_.light_to_camera) {
       if (splat_image_.width() != film.width()) splat_image_ = Image(film.width(), film.height());
       std::fill(splat_image_.pixels().begin(), splat_image_.pixels().end(), Rgb(0.f));
@@ -260,60 +342,63 @@ class BidirIntegrator final : public CameraPathIntegrator {
     for (size_t i = 0; i < tokens; ++i) free_buffers.push_back(&chunk_buffers_[i]);
     std::mutex free_mutex;
     uint64_t next_chunk = 0, nonfinite = 0;
-    tbb::parallel_pipeline(tokens,
-                           tbb::make_filter<void, uint64_t>(tbb::filter_mode::serial_in_order,
-                                                            [&](tbb::flow_control& fc) -> uint64_t {
-                                                              if (next_chunk == chunk_count_)
-                                                                fc.stop();
-                                                              return next_chunk++;
-                                                            }) &
-                               tbb::make_filter<uint64_t, LightChunk*>(
-                                   tbb::filter_mode::parallel,
-                                   [&](uint64_t c) {
-                                     LightChunk* chunk;
-                                     {
-                                       const std::lock_guard<std::mutex> lock(free_mutex);
-                                       chunk = free_buffers.back();
-                                       free_buffers.pop_back();
-                                     }
-                                     trace_chunk(scene, it, c, *chunk);
-                                     return chunk;
-                                   }) &
-                               tbb::make_filter<LightChunk*, void>(
-                                   tbb::filter_mode::serial_in_order, [&](LightChunk* chunk) {
-                                     append_chunk(*chunk);
-                                     nonfinite += chunk->nonfinite;
-                                     const std::lock_guard<std::mutex> lock(free_mutex);
-                                     free_buffers.push_back(chunk);
-                                   }));
-    path_begin_[light_paths_] = uint32_t(vertices_.size());
+    if (tokens > 0)
+      tbb::parallel_pipeline(
+          tokens, tbb::make_filter<void, uint64_t>(tbb::filter_mode::serial_in_order,
+                                                   [&](tbb::flow_control& fc) -> uint64_t {
+                                                     if (next_chunk == chunk_count_) fc.stop();
+                                                     return next_chunk++;
+                                                   }) &
+                      tbb::make_filter<uint64_t, LightChunk*>(
+                          tbb::filter_mode::parallel,
+                          [&](uint64_t c) {
+                            LightChunk* chunk;
+                            {
+                              const std::lock_guard<std::mutex> lock(free_mutex);
+                              chunk = free_buffers.back();
+                              free_buffers.pop_back();
+                            }
+                            trace_chunk(scene, it, c, *chunk);
+                            return chunk;
+                          }) &
+                      tbb::make_filter<LightChunk*, void>(
+                          tbb::filter_mode::serial_in_order, [&](LightChunk* chunk) {
+                            append_chunk(it, *chunk);
+                            nonfinite += chunk->nonfinite;
+                            const std::lock_guard<std::mutex> lock(free_mutex);
+                            free_buffers.push_back(chunk);
+                          }));
+    path_begin_[it.plan.light_paths] = uint32_t(vertices_.size());
     if (tech_.light_to_camera) {
       if (nonfinite) film.count_nonfinite(nonfinite);
       film.add_image(splat_image_);
     }
-    light_seconds_total_ +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    light_seconds_total_ += seconds_since(start);
   }
 
-  // Light paths [first, last) of chunk c, traced into chunk (its storage reused).
+  // Light paths of chunk c, traced into chunk (its storage reused).
   void trace_chunk(const Scene& scene, const Iteration& it, uint64_t c, LightChunk& chunk) const {
     thread_local ScratchArena arena;
     chunk.vertices.clear();
     chunk.path_ends.clear();
     chunk.splats.clear();
+    chunk.splat_terms.clear();
     chunk.nonfinite = 0;
+    const auto chunk_start = std::chrono::steady_clock::now();
     chunk.first_path = c * chunk_paths_;
-    const uint64_t last = std::min<uint64_t>(chunk.first_path + chunk_paths_, light_paths_);
+    const uint64_t last = std::min<uint64_t>(chunk.first_path + chunk_paths_, it.plan.light_paths);
     for (uint64_t path = chunk.first_path; path < last; ++path) {
       arena.reset();
       trace_light_path(scene, it, path, chunk, arena);
       chunk.path_ends.push_back(uint32_t(chunk.vertices.size()));
     }
+    chunk.seconds =
+        it.plan.probe && settings_.bidir.measured_costs ? seconds_since(chunk_start) : 0;
   }
 
   // The next chunk in path order: vertex i of path p lands at path_begin_[p] + i; its splats
   // are added in the order they were made (deterministic sums).
-  void append_chunk(const LightChunk& chunk) {
+  void append_chunk(const Iteration& it, const LightChunk& chunk) {
     const size_t need = vertices_.size() + chunk.vertices.size();
     if (need > vertices_.capacity()) {
       // Grow to what the chunks so far predict for the whole iteration, plus a tenth, rather
@@ -326,9 +411,14 @@ class BidirIntegrator final : public CameraPathIntegrator {
     vertices_.insert(vertices_.end(), chunk.vertices.begin(), chunk.vertices.end());
     for (size_t i = 0; i < chunk.path_ends.size(); ++i)
       path_begin_[chunk.first_path + i] = base + (i ? chunk.path_ends[i - 1] : 0);
-    for (const Splat& s : chunk.splats) {
+    light_chunk_seconds_ += chunk.seconds;
+    for (size_t i = 0; i < chunk.splats.size(); ++i) {
+      const Splat& s = chunk.splats[i];
       splat_image_[s.pixel] += s.value;
       if (techniques_.enabled()) techniques_.add(s.technique, s.pixel, s.value);
+      if (it.plan.probe)
+        plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[i], it.rules.counts(),
+                              it.radius);
     }
   }
 
@@ -415,25 +505,28 @@ class BidirIntegrator final : public CameraPathIntegrator {
     // N light paths. Every pixel whose filter support holds the raster point r gets a splat,
     // MIS-weighted against its own camera technique (raster density pdf(r - c_p)).
     const float scale =
-        cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(light_paths_));
+        cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(it.plan.light_paths));
     const size_t first_splat = chunk.splats.size();
     filter_.for_each_pixel(
         cs->raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
-          const float w = tech_.unweighted
-                              ? 1.f
-                              : bidir::weight_light_to_camera(it.rules, camera, si, bsdf, si.wo,
-                                                              mis, cs->p_lens, fs.pdf);
+          const uint32_t pixel = uint32_t(y * camera.width() + x);
+          const MisRules& rules = it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
+          const bidir::TechniqueTerms terms =
+              bidir::terms_light_to_camera(rules, camera, si, bsdf, si.wo, mis, cs->p_lens, fs.pdf);
+          const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
           const Rgb value = beta * f * (scale * w) * (fs.weight * fs.pdf);
           if (value.is_black()) return;
           if (!value.is_finite()) {
             ++chunk.nonfinite;
             return;
           }
-          chunk.splats.push_back(
-              {uint32_t(y * camera.width() + x), TechniqueImages::key(false, depth + 1, 1), value});
+          chunk.splats.push_back({pixel, TechniqueImages::key(false, depth + 1, 1), value});
+          if (it.plan.probe) chunk.splat_terms.push_back(terms);
         });
-    if (chunk.splats.size() > first_splat && scene.occluded(si.spawn_ray_to(cs->p_lens)))
+    if (chunk.splats.size() > first_splat && scene.occluded(si.spawn_ray_to(cs->p_lens))) {
       chunk.splats.resize(first_splat);
+      if (it.plan.probe) chunk.splat_terms.resize(first_splat);
+    }
   }
 
   // ---- camera subpaths ----------------------------------------------------------------------
@@ -444,9 +537,34 @@ class BidirIntegrator final : public CameraPathIntegrator {
     acc.pixel = sample.pixel;
     acc.filter_weight = sample.filter_weight;
     if (techniques_.enabled()) acc.techniques = &techniques_;
-    camera_path(scene, current_, sample, rng, acc, arena);
+    const Iteration& it = current_;
+    acc.rules = it.plan.merges(sample.pixel) ? &it.rules : &it.rules_no_merge;
+    if (it.plan.probe) {
+      acc.plan = &plan_;
+      acc.radius = it.radius;
+      acc.candidate_sums = plan_.pixel_start(sample.pixel);
+    }
+    const auto start = std::chrono::steady_clock::now();
+    camera_path(scene, it, sample, rng, acc, arena);
     *nonfinite += acc.nonfinite;
+    if (it.plan.probe) {
+      plan_.pixel_end(sample.pixel, acc.candidate_sums);
+      if (settings_.bidir.measured_costs) acc.work.camera_seconds = seconds_since(start);
+      add_probe_work(acc.work);
+    }
     return acc.sum;
+  }
+
+  void add_probe_work(const bidir::ProbeWork& w) const {
+    std::lock_guard<std::mutex> lock(probe_mutex_);
+    probe_.camera_vertices += w.camera_vertices;
+    probe_.nondelta_camera_vertices += w.nondelta_camera_vertices;
+    probe_.connections += w.connections;
+    probe_.merge_queries += w.merge_queries;
+    probe_.photons += w.photons;
+    probe_.camera_seconds += w.camera_seconds;
+    probe_.connect_seconds += w.connect_seconds;
+    probe_.merge_seconds += w.merge_seconds;
   }
 
   void camera_path(const Scene& scene, const Iteration& it, const CameraSample& sample, Pcg32& rng,
@@ -457,7 +575,10 @@ class BidirIntegrator final : public CameraPathIntegrator {
     Ray ray = sample.ray;
     const float pdf_camera = bidir::camera_pdf_w(camera, ray.o, ray.d, sample.filter_pdf);
     if (!(pdf_camera > 0)) return;
-    MisSums mis = it.rules.camera_start(pdf_camera);
+    const MisRules& rules = *acc.rules;
+    const bool merges = tech_.merge && it.plan.merges(pixel);
+    const bool timed = acc.plan && settings_.bidir.measured_costs;
+    MisSums mis = rules.camera_start(pdf_camera);
     const int max_depth = settings_.max_depth;
     const uint64_t light_path = it.light_path_of.light_path(pixel);
 
@@ -468,10 +589,15 @@ class BidirIntegrator final : public CameraPathIntegrator {
     float segment = 0;
     float eta_scale = 1;
     // Emitters: MIS-weighted when connections take part, else only via delta-only chains.
+    bidir::TechniqueTerms terms;
+    bool weighted = false;  // the last emitter weight came from terms
     auto emitter_weight = [&](const Light& light, const SurfaceInteraction* hit, const MisSums& m) {
+      weighted = false;
       if (depth == 0) return 1.f;
       if (!tech_.connect) return specular_path ? 1.f : 0.f;
-      return bidir::weight_emitter_hit(it.rules, light, lights.pmf(&light), prev_p, ray.d, hit, m);
+      weighted = true;
+      terms = bidir::terms_emitter_hit(rules, light, lights.pmf(&light), prev_p, ray.d, hit, m);
+      return terms.weight(rules.counts());
     };
 
     for (;;) {
@@ -479,7 +605,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
       if (!scene.intersect(ray, &si)) {
         for_each_emitter_seen(scene.infinite_lights(), ray, nullptr, [&](const Light& l, Rgb Le) {
           const float w = emitter_weight(l, nullptr, mis);
-          if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w);
+          if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w, weighted ? &terms : nullptr);
         });
         break;
       }
@@ -487,11 +613,11 @@ class BidirIntegrator final : public CameraPathIntegrator {
       Bsdf bsdf;
       if (si.material) bsdf = si.material->bsdf(si, arena);
       MisSums at_hit = mis;
-      it.rules.hit(at_hit, segment * segment, bidir::geometric_cos(si, si.wo));
+      rules.hit(at_hit, segment * segment, bidir::geometric_cos(si, si.wo));
 
       for_each_emitter_seen(scene.infinite_lights(), ray, &si, [&](const Light& l, Rgb Le) {
         const float w = emitter_weight(l, &si, at_hit);
-        if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w);
+        if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w, weighted ? &terms : nullptr);
       });
       if (!bsdf.valid()) {
         ray = si.spawn_ray(ray.d);
@@ -503,12 +629,21 @@ class BidirIntegrator final : public CameraPathIntegrator {
       if (depth > max_depth) break;
 
       const bool delta = bsdf.is_delta();
+      ++acc.work.camera_vertices;
       if (!delta) {
+        ++acc.work.nondelta_camera_vertices;
         if (tech_.connect) {
-          next_event(scene, it, si, bsdf, beta, mis, depth, rng, acc);
-          connect_to_light_path(scene, it, si, bsdf, beta, mis, depth, light_path, arena, acc);
+          next_event(scene, rules, si, bsdf, beta, mis, depth, rng, acc);
+          const auto t0 = timed ? std::chrono::steady_clock::now() : Clock::time_point{};
+          connect_to_light_paths(scene, it, rules, si, bsdf, beta, mis, depth, light_path, rng,
+                                 arena, acc);
+          if (timed) acc.work.connect_seconds += seconds_since(t0);
         }
-        if (tech_.merge) merge(scene, it, si, bsdf, beta, mis, depth, acc);
+        if (merges) {
+          const auto t0 = timed ? std::chrono::steady_clock::now() : Clock::time_point{};
+          merge(scene, it, rules, si, bsdf, beta, mis, depth, acc);
+          if (timed) acc.work.merge_seconds += seconds_since(t0);
+        }
       }
 
       const float uc = rng.next_float();
@@ -519,7 +654,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
       if (tech_.camera_stops && !delta && !bs->is_specular()) break;
       const float pdf_fwd =
           bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Radiance) : bs->pdf;
-      bidir::scatter_update(it.rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Radiance,
+      bidir::scatter_update(rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Radiance,
                             bs->is_specular(), pdf_fwd);
       beta *= bs->f * (bsdf.abs_cos(bs->wi) / bs->pdf);
       specular_path = specular_path && bs->is_specular();
@@ -531,24 +666,44 @@ class BidirIntegrator final : public CameraPathIntegrator {
     }
   }
 
-  void next_event(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
+  void next_event(const Scene& scene, const MisRules& rules, const SurfaceInteraction& si,
                   const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth, Pcg32& rng,
                   PixelAccumulator& acc) const {
     const float u_light = rng.next_float();
     const Vec2 u = rng.next_2d();
     const auto d = sample_direct_light(scene, si, bsdf, u_light, u);
     if (!d) return;
-    const float w = bidir::weight_next_event(it.rules, *d->light, d->pmf, d->ls, si, bsdf, mis);
+    const bidir::TechniqueTerms terms =
+        bidir::terms_next_event(rules, *d->light, d->pmf, d->ls, si, bsdf, mis);
+    const float w = terms.weight(rules.counts());
     const Rgb value = beta * d->f * d->ls.radiance * (w / (d->pmf * d->ls.pdf_w));
     if (value.is_black()) return;
     if (scene.occluded(d->shadow)) return;
-    acc.add(false, 1, depth + 1, value);
+    acc.add(false, 1, depth + 1, value, &terms);
   }
 
-  void connect_to_light_path(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
-                             const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth,
-                             uint64_t light_path, ScratchArena& arena,
-                             PixelAccumulator& acc) const {
+  // Connections to the vertices of `connections` light paths: the pixel's own, then paths drawn
+  // uniformly (each light path is an independent sample, so any choice is unbiased); each
+  // connection is one of c samples, hence the 1 / c.
+  void connect_to_light_paths(const Scene& scene, const Iteration& it, const MisRules& rules,
+                              const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
+                              const MisSums& mis, int depth, uint64_t light_path, Pcg32& rng,
+                              ScratchArena& arena, PixelAccumulator& acc) const {
+    const uint64_t n = it.plan.light_paths;
+    const int c = it.plan.connections;
+    if (n == 0 || c == 0) return;
+    const Rgb scaled = beta / float(c);
+    for (int j = 0; j < c; ++j) {
+      const uint64_t path =
+          j == 0 ? light_path : std::min<uint64_t>(uint64_t(rng.next_float() * double(n)), n - 1);
+      connect_to_light_path(scene, rules, si, bsdf, scaled, mis, depth, path, arena, acc);
+    }
+  }
+
+  void connect_to_light_path(const Scene& scene, const MisRules& rules,
+                             const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
+                             const MisSums& mis, int depth, uint64_t light_path,
+                             ScratchArena& arena, PixelAccumulator& acc) const {
     for (uint32_t i = path_begin_[light_path]; i < path_begin_[light_path + 1]; ++i) {
       const LightVertex& stored = vertices_[i];
       // Stored in increasing depth: once too long, all the rest are too.
@@ -566,12 +721,14 @@ class BidirIntegrator final : public CameraPathIntegrator {
       const Rgb f_light =
           light_bsdf.f(v.wo, -dir, TransportMode::Importance) * light_bsdf.abs_cos(dir);
       if (f_light.is_black()) continue;
-      const float w =
-          bidir::weight_connection(it.rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf, mis);
+      ++acc.work.connections;
+      const bidir::TechniqueTerms terms =
+          bidir::terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf, mis);
+      const float w = terms.weight(rules.counts());
       const Rgb value = beta * v.throughput * f_camera * f_light * (w / dist2);
       if (value.is_black()) continue;
       if (scene.occluded(spawn_ray_between(si, light_si))) continue;
-      acc.add(false, v.depth + 1, depth + 1, value);
+      acc.add(false, v.depth + 1, depth + 1, value, &terms);
     }
   }
 
@@ -584,13 +741,15 @@ class BidirIntegrator final : public CameraPathIntegrator {
   //    ray from the query to a point just off the photon on the side it arrived from. Photons
   //    on the query's own shape are trusted, so the ray is traced only near shape boundaries.
   // Each test only removes photons; at distance 0 (the partition test's merges) all pass.
-  void merge(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
-             const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth,
-             PixelAccumulator& acc) const {
+  void merge(const Scene& scene, const Iteration& it, const MisRules& rules,
+             const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta, const MisSums& mis,
+             int depth, PixelAccumulator& acc) const {
+    ++acc.work.merge_queries;
     const int max_depth = settings_.max_depth;
     const Scene::PrimitiveRange own_shape = scene.shape_primitives(si);
     const float max_off_plane = 0.5f * it.radius;
     grid_.for_each_near(si.p, vertices_, [&](uint32_t index, Vec3 q) {
+      ++acc.work.photons;
       const LightVertex& stored = vertices_[index];
       const int light_depth = bidir::light_vertex_depth(stored);
       if (light_depth + depth - 1 > max_depth) return;
@@ -607,10 +766,10 @@ class BidirIntegrator final : public CameraPathIntegrator {
       if (!own_shape.contains(v.primitive) &&
           !photon_visible(scene, si, v.primitive, q, v.wo, it.radius))
         return;
-      const float w =
-          tech_.unweighted ? 1.f : bidir::weight_merge(it.rules, v.wo, v.mis, si, bsdf, mis);
+      const bidir::TechniqueTerms terms = bidir::terms_merge(rules, v.wo, v.mis, si, bsdf, mis);
+      const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
       acc.add(true, light_depth + 1, depth + 1,
-              beta * f * v.throughput * (w * it.merge_normalization));
+              beta * f * v.throughput * (w * it.merge_normalization), &terms);
     });
   }
 
@@ -645,6 +804,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
   uint64_t chunk_paths_ = kMaxChunkPaths;  // light paths per chunk (chunk_paths_for)
   uint64_t chunk_count_ = 0;
   std::vector<LightChunk> chunk_buffers_;  // one per chunk in flight (trace_light_paths)
+  double light_chunk_seconds_ = 0;         // probe iterations: the chunks' tracing times, summed
   std::vector<LightVertex> vertices_;
   std::vector<uint32_t> path_begin_;
   HashGrid grid_;
@@ -659,6 +819,11 @@ class BidirIntegrator final : public CameraPathIntegrator {
   double grid_seconds_total_ = 0;   // of seconds_total_, building the hash grid
   double light_seconds_total_ = 0;  // of seconds_total_, tracing light paths (with their splats)
   std::vector<std::string> technique_files_;
+
+  // adaptive-vcm: the plan, and the work of the current probe iteration.
+  mutable bidir::AdaptivePlan plan_;
+  mutable bidir::ProbeWork probe_;
+  mutable std::mutex probe_mutex_;
 };
 
 }  // namespace

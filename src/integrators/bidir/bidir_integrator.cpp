@@ -1,6 +1,8 @@
 #include "integrators/bidir/bidir_integrator.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include <array>
 #include <atomic>
@@ -115,6 +117,7 @@ float scalar(Rgb v) { return (v.r + v.g + v.b) * (1.f / 3.f); }
 
 // What one chunk of light paths leaves behind.
 struct LightChunk {
+  uint64_t first_path = 0;
   std::vector<LightVertex> vertices;
   std::vector<uint32_t> path_ends;  // per path: vertices.size() after it
   std::vector<Splat> splats;
@@ -234,6 +237,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
     probe_ = {};
     probe_.light_paths = double(n);
     if (it.plan.probe) plan_.begin_probe();
+    // Before this iteration adds anything: the film adds estimates to its totals as they come.
+    const std::vector<float> means_before =
+        it.plan.probe ? pixel_means(film) : std::vector<float>();
 
     const auto light_start = std::chrono::steady_clock::now();
     size_chunks(n);
@@ -255,10 +261,10 @@ class BidirIntegrator final : public CameraPathIntegrator {
     if (it.plan.probe) {
       probe_.light_vertices = double(vertices_.size());
       probe_.light_seconds = 0;
-      for (const LightChunk& c : chunks_) probe_.light_seconds += c.seconds;
+      probe_.light_seconds = light_chunk_seconds_;
       if (probe_.light_seconds == 0) probe_.light_seconds = light_seconds;
       if (probe_.camera_seconds == 0) probe_.camera_seconds = seconds_since(camera_start);
-      plan_.finish_probe(probe_, pixel_means(film));
+      plan_.finish_probe(probe_, means_before);
     }
 
     ++iterations_;
@@ -290,6 +296,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
     b["radius_last"] = last_radius_;
     b["radius_alpha"] = settings_.bidir.radius_alpha;
     b["ms_per_iteration"] = iterations_ ? 1e3 * seconds_total_ / iterations_ : 0.0;
+    b["light_paths_ms_per_iteration"] =
+        iterations_ ? 1e3 * light_seconds_total_ / iterations_ : 0.0;
     if (!technique_files_.empty()) b["technique_images"] = technique_files_;
     stats["bidir"] = b;
   }
@@ -297,7 +305,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
  private:
   bool stores_vertices() const { return tech_.connect || tech_.merge; }
 
-  // Scalar pixel means of the film's completed iterations (empty before the first).
+  // Scalar pixel means of the film's completed iterations (empty before the first); between
+  // iterations only (film.h).
   static std::vector<float> pixel_means(const Film& film) {
     if (film.iterations() == 0) return {};
     const Image image = film.image();
@@ -309,69 +318,108 @@ class BidirIntegrator final : public CameraPathIntegrator {
   // Chunks for n light paths (chunk_paths_for).
   void size_chunks(uint64_t n) {
     chunk_paths_ = chunk_paths_for(std::max<uint64_t>(n, 1));
-    chunks_.resize(n ? (n + chunk_paths_ - 1) / chunk_paths_ : 0);
-    chunk_offset_.resize(chunks_.size());
+    chunk_count_ = n ? (n + chunk_paths_ - 1) / chunk_paths_ : 0;
   }
 
   // ---- light subpaths -----------------------------------------------------------------------
+  // Chunks are traced in parallel into a few reused buffers and appended, in chunk order, to
+  // vertices_ and the splat image as they finish (a pipeline whose last stage is serial and in
+  // order): no chunk is kept once appended, so the vertices are held once, not per chunk and
+  // again concatenated, and the result is the concatenation in path order for any threads.
   void trace_light_paths(const Scene& scene, const Iteration& it, Film& film) {
-    tbb::parallel_for(size_t(0), chunks_.size(), [&](size_t c) {
-      thread_local ScratchArena arena;
-      LightChunk& chunk = chunks_[c];
-      chunk.vertices.clear();
-      chunk.path_ends.clear();
-      chunk.splats.clear();
-      chunk.splat_terms.clear();
-      chunk.nonfinite = 0;
-      const auto chunk_start = std::chrono::steady_clock::now();
-      const uint64_t first = c * chunk_paths_,
-                     last = std::min<uint64_t>(first + chunk_paths_, it.plan.light_paths);
-      for (uint64_t path = first; path < last; ++path) {
-        arena.reset();
-        trace_light_path(scene, it, path, chunk, arena);
-        chunk.path_ends.push_back(uint32_t(chunk.vertices.size()));
-      }
-      chunk.seconds =
-          it.plan.probe && settings_.bidir.measured_costs ? seconds_since(chunk_start) : 0;
-    });
-
-    // Concatenate in chunk order: vertex i of path p is at path_begin_[p] + i.
-    size_t total = 0;
-    for (const LightChunk& c : chunks_) total += c.vertices.size();
-    vertices_.resize(total);
+    const auto start = std::chrono::steady_clock::now();
+    vertices_.clear();
     path_begin_.resize(it.plan.light_paths + 1);
-    std::vector<size_t>& chunk_offset = chunk_offset_;
-    for (size_t c = 0, offset = 0; c < chunks_.size(); ++c) {
-      chunk_offset[c] = offset;
-      offset += chunks_[c].vertices.size();
+    light_chunk_seconds_ = 0;
+    if (tech_.light_to_camera) {
+      if (splat_image_.width() != film.width()) splat_image_ = Image(film.width(), film.height());
+      std::fill(splat_image_.pixels().begin(), splat_image_.pixels().end(), Rgb(0.f));
     }
-    tbb::parallel_for(size_t(0), chunks_.size(), [&](size_t c) {
-      const LightChunk& chunk = chunks_[c];
-      std::copy(chunk.vertices.begin(), chunk.vertices.end(), vertices_.begin() + chunk_offset[c]);
-      const uint64_t first = c * chunk_paths_;
-      for (size_t i = 0; i < chunk.path_ends.size(); ++i) {
-        path_begin_[first + i] = uint32_t(chunk_offset[c] + (i ? chunk.path_ends[i - 1] : 0));
-      }
-    });
-    path_begin_[it.plan.light_paths] = uint32_t(total);
+    const size_t tokens = std::min<size_t>(
+        chunk_count_, 4 * size_t(std::max(1, tbb::this_task_arena::max_concurrency())));
+    if (chunk_buffers_.size() < tokens) chunk_buffers_.resize(tokens);
+    std::vector<LightChunk*> free_buffers;
+    for (size_t i = 0; i < tokens; ++i) free_buffers.push_back(&chunk_buffers_[i]);
+    std::mutex free_mutex;
+    uint64_t next_chunk = 0, nonfinite = 0;
+    if (tokens > 0)
+      tbb::parallel_pipeline(
+          tokens, tbb::make_filter<void, uint64_t>(tbb::filter_mode::serial_in_order,
+                                                   [&](tbb::flow_control& fc) -> uint64_t {
+                                                     if (next_chunk == chunk_count_) fc.stop();
+                                                     return next_chunk++;
+                                                   }) &
+                      tbb::make_filter<uint64_t, LightChunk*>(
+                          tbb::filter_mode::parallel,
+                          [&](uint64_t c) {
+                            LightChunk* chunk;
+                            {
+                              const std::lock_guard<std::mutex> lock(free_mutex);
+                              chunk = free_buffers.back();
+                              free_buffers.pop_back();
+                            }
+                            trace_chunk(scene, it, c, *chunk);
+                            return chunk;
+                          }) &
+                      tbb::make_filter<LightChunk*, void>(
+                          tbb::filter_mode::serial_in_order, [&](LightChunk* chunk) {
+                            append_chunk(it, *chunk);
+                            nonfinite += chunk->nonfinite;
+                            const std::lock_guard<std::mutex> lock(free_mutex);
+                            free_buffers.push_back(chunk);
+                          }));
+    path_begin_[it.plan.light_paths] = uint32_t(vertices_.size());
+    if (tech_.light_to_camera) {
+      if (nonfinite) film.count_nonfinite(nonfinite);
+      film.add_image(splat_image_);
+    }
+    light_seconds_total_ += seconds_since(start);
+  }
 
-    if (!tech_.light_to_camera) return;
-    if (splat_image_.width() != film.width()) splat_image_ = Image(film.width(), film.height());
-    std::fill(splat_image_.pixels().begin(), splat_image_.pixels().end(), Rgb(0.f));
-    uint64_t nonfinite = 0;
-    for (const LightChunk& chunk : chunks_) {  // fixed order: deterministic sums
-      nonfinite += chunk.nonfinite;
-      for (size_t i = 0; i < chunk.splats.size(); ++i) {
-        const Splat& s = chunk.splats[i];
-        splat_image_[s.pixel] += s.value;
-        if (techniques_.enabled()) techniques_.add(s.technique, s.pixel, s.value);
-        if (it.plan.probe)
-          plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[i], it.rules.counts(),
-                                it.radius);
-      }
+  // Light paths of chunk c, traced into chunk (its storage reused).
+  void trace_chunk(const Scene& scene, const Iteration& it, uint64_t c, LightChunk& chunk) const {
+    thread_local ScratchArena arena;
+    chunk.vertices.clear();
+    chunk.path_ends.clear();
+    chunk.splats.clear();
+    chunk.splat_terms.clear();
+    chunk.nonfinite = 0;
+    const auto chunk_start = std::chrono::steady_clock::now();
+    chunk.first_path = c * chunk_paths_;
+    const uint64_t last = std::min<uint64_t>(chunk.first_path + chunk_paths_, it.plan.light_paths);
+    for (uint64_t path = chunk.first_path; path < last; ++path) {
+      arena.reset();
+      trace_light_path(scene, it, path, chunk, arena);
+      chunk.path_ends.push_back(uint32_t(chunk.vertices.size()));
     }
-    if (nonfinite) film.count_nonfinite(nonfinite);
-    film.add_image(splat_image_);
+    chunk.seconds =
+        it.plan.probe && settings_.bidir.measured_costs ? seconds_since(chunk_start) : 0;
+  }
+
+  // The next chunk in path order: vertex i of path p lands at path_begin_[p] + i; its splats
+  // are added in the order they were made (deterministic sums).
+  void append_chunk(const Iteration& it, const LightChunk& chunk) {
+    const size_t need = vertices_.size() + chunk.vertices.size();
+    if (need > vertices_.capacity()) {
+      // Grow to what the chunks so far predict for the whole iteration, plus a tenth, rather
+      // than by doubling: this is the largest buffer, kept from one iteration to the next.
+      const uint64_t chunks_done = chunk.first_path / chunk_paths_ + 1;
+      const size_t predicted = size_t(double(need) * double(chunk_count_) / double(chunks_done));
+      vertices_.reserve(std::max(need, predicted + predicted / 10));
+    }
+    const uint32_t base = uint32_t(vertices_.size());
+    vertices_.insert(vertices_.end(), chunk.vertices.begin(), chunk.vertices.end());
+    for (size_t i = 0; i < chunk.path_ends.size(); ++i)
+      path_begin_[chunk.first_path + i] = base + (i ? chunk.path_ends[i - 1] : 0);
+    light_chunk_seconds_ += chunk.seconds;
+    for (size_t i = 0; i < chunk.splats.size(); ++i) {
+      const Splat& s = chunk.splats[i];
+      splat_image_[s.pixel] += s.value;
+      if (techniques_.enabled()) techniques_.add(s.technique, s.pixel, s.value);
+      if (it.plan.probe)
+        plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[i], it.rules.counts(),
+                              it.radius);
+    }
   }
 
   void trace_light_path(const Scene& scene, const Iteration& it, uint64_t path, LightChunk& chunk,
@@ -754,8 +802,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
   // Per-iteration buffers, reused.
   uint64_t chunk_paths_ = kMaxChunkPaths;  // light paths per chunk (chunk_paths_for)
-  std::vector<LightChunk> chunks_;
-  std::vector<size_t> chunk_offset_;  // per chunk: its first vertex in vertices_
+  uint64_t chunk_count_ = 0;
+  std::vector<LightChunk> chunk_buffers_;  // one per chunk in flight (trace_light_paths)
+  double light_chunk_seconds_ = 0;         // probe iterations: the chunks' tracing times, summed
   std::vector<LightVertex> vertices_;
   std::vector<uint32_t> path_begin_;
   HashGrid grid_;
@@ -767,7 +816,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
   uint32_t iterations_ = 0;
   uint64_t vertices_total_ = 0;
   double seconds_total_ = 0;
-  double grid_seconds_total_ = 0;  // of seconds_total_, building the hash grid
+  double grid_seconds_total_ = 0;   // of seconds_total_, building the hash grid
+  double light_seconds_total_ = 0;  // of seconds_total_, tracing light paths (with their splats)
   std::vector<std::string> technique_files_;
 
   // adaptive-vcm: the plan, and the work of the current probe iteration.

@@ -248,7 +248,8 @@ void add_render_functions(py::module_& m) {
         "light_paths (light subpaths per iteration, >= 1; default: one per pixel), radius "
         "(initial merge radius, > 0; default: from the scene size), radius_alpha (in (0, 1]; "
         "default 0.75), connections (light subpaths per camera vertex for bpt/vcm, 1..64), "
-        "adaptive_costs ('model' or 'measured', adaptive-vcm). None means not given. Unknown names or bad values raise ValueError.\n"
+        "adaptive_costs ('model' or 'measured', adaptive-vcm). None means not given. Unknown names "
+        "or bad values raise ValueError.\n"
         "Releases the GIL; Ctrl-C ends the render after its current iteration and raises "
         "KeyboardInterrupt.");
 

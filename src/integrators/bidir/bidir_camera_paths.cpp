@@ -60,8 +60,6 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   const float pdf_camera = camera_pdf_w(camera, ray.o, ray.d, sample.filter_pdf);
   if (!(pdf_camera > 0)) return;
   const MisRules& rules = *acc.rules;
-  const bool merges = tech_.merge && it.plan.merges(pixel);
-  const bool timed = acc.plan && settings_.bidir.measured_costs;
   MisSums mis = rules.camera_start(pdf_camera);
   const int max_depth = settings_.max_depth;
   const uint64_t light_path = it.light_path_of.light_path(pixel);
@@ -114,21 +112,8 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
 
     const bool delta = bsdf.is_delta();
     ++acc.work.camera_vertices;
-    if (!delta) {
-      ++acc.work.nondelta_camera_vertices;
-      if (tech_.connect) {
-        next_event(scene, rules, si, bsdf, beta, mis, depth, rng, acc);
-        const auto t0 = timed ? std::chrono::steady_clock::now() : Clock::time_point{};
-        connect_to_light_paths(scene, it, rules, si, bsdf, beta, mis, depth, light_path, rng, arena,
-                               acc);
-        if (timed) acc.work.connect_seconds += seconds_since(t0);
-      }
-      if (merges) {
-        const auto t0 = timed ? std::chrono::steady_clock::now() : Clock::time_point{};
-        merge(scene, it, rules, si, bsdf, beta, mis, depth, acc);
-        if (timed) acc.work.merge_seconds += seconds_since(t0);
-      }
-    }
+    if (!delta)
+      vertex_techniques(scene, it, {si, bsdf, beta, mis, depth}, light_path, rng, arena, acc);
 
     const float uc = rng.next_float();
     const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Radiance);
@@ -147,6 +132,26 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     prev_p = si.p;
     ray = si.spawn_ray(bs->wi);
     if (!survives_russian_roulette(beta, eta_scale, depth, rng)) break;
+  }
+}
+
+void BidirIntegrator::vertex_techniques(const Scene& scene, const Iteration& it,
+                                        const CameraVertex& v, uint64_t light_path, Pcg32& rng,
+                                        ScratchArena& arena, PixelAccumulator& acc) const {
+  const MisRules& rules = *acc.rules;
+  const bool timed = acc.plan && settings_.bidir.measured_costs;
+  ++acc.work.nondelta_camera_vertices;
+  if (tech_.connect) {
+    next_event(scene, rules, v.si, v.bsdf, v.beta, v.mis, v.depth, rng, acc);
+    const auto t0 = timed ? std::chrono::steady_clock::now() : Clock::time_point{};
+    connect_to_light_paths(scene, it, rules, v.si, v.bsdf, v.beta, v.mis, v.depth, light_path, rng,
+                           arena, acc);
+    if (timed) acc.work.connect_seconds += seconds_since(t0);
+  }
+  if (tech_.merge && it.plan.merges(acc.pixel)) {
+    const auto t0 = timed ? std::chrono::steady_clock::now() : Clock::time_point{};
+    merge(scene, it, rules, v.si, v.bsdf, v.beta, v.mis, v.depth, acc);
+    if (timed) acc.work.merge_seconds += seconds_since(t0);
   }
 }
 

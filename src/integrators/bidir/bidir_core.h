@@ -173,6 +173,18 @@ class BidirIntegrator final : public CameraPathIntegrator {
   void camera_path(const Scene& scene, const Iteration& it, const CameraSample& sample, Pcg32& rng,
                    PixelAccumulator& acc, ScratchArena& arena) const;
 
+  // The techniques at a non-delta camera vertex: NEE, connections, merging.
+  struct CameraVertex {
+    const SurfaceInteraction& si;
+    const Bsdf& bsdf;
+    Rgb beta;
+    const MisSums& mis;
+    int depth;
+  };
+  void vertex_techniques(const Scene& scene, const Iteration& it, const CameraVertex& v,
+                         uint64_t light_path, Pcg32& rng, ScratchArena& arena,
+                         PixelAccumulator& acc) const;
+
   void next_event(const Scene& scene, const MisRules& rules, const SurfaceInteraction& si,
                   const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth, Pcg32& rng,
                   PixelAccumulator& acc) const;

@@ -12,17 +12,21 @@
 namespace caustica::bidir {
 
 namespace {
-// The fixed cost model, in microseconds per operation: medians of what --adaptive-costs measured
-// reports on the development machine (2-core x86-64, g++ 12 Release, 1 thread, 2026-11-30) on
-// door-ajar, mis-plates, water-caustic and cornell-box (light vertices ranged 0.85-2.3 us with
-// the scene). Used whenever costs are not measured live, so that a render at fixed spp and seed
-// chooses the same configurations on every machine and for every thread count.
+// The fixed cost model, in microseconds per operation: a least-squares fit of camera-pass and
+// light-pass times to the operation counts (statistics "work_per_iteration") of vcm and bpt at
+// 1 and 4 connections and 0.25-2 light paths per pixel on door-ajar, cornell-box, veach-bidir
+// and water-caustic (1 thread, 2-core x86-64, g++ 12 Release, 2026-11-30; per scene the camera
+// vertex ranged 0.6-1.0 us, a connection 0.5-0.7, a light vertex 0.8-2.0). Scenes whose BSDFs
+// are expensive to evaluate (coated materials: material-testball fits 2.9 / 8.6 / 4.4) are
+// mispriced; --adaptive-costs measured times the probes instead. Used whenever costs are not
+// measured, so that a render at fixed spp and seed chooses the same configurations on every
+// machine and for every thread count.
 struct CostModel {
-  double camera_vertex = 0.8;  // trace, BSDF, NEE with its shadow ray
-  double light_vertex = 1.3;   // trace, BSDF, store, connect to the lens
-  double connection = 0.8;     // one light vertex connected to one camera vertex
-  double merge_query = 0.3;    // one range query
-  double photon = 0.06;        // one photon gathered
+  double camera_vertex = 0.75;  // trace, BSDF, NEE with its shadow ray
+  double light_vertex = 1.1;    // trace, BSDF, store, connect to the lens
+  double connection = 0.6;      // one light vertex connected to one camera vertex
+  double merge_query = 0.18;    // one range query
+  double photon = 0.03;         // one photon gathered
 };
 constexpr float kLightPathFactors[] = {0.25f, 0.5f, 1.f, 2.f};
 constexpr int kConnections[] = {0, 1, 2, 4};
@@ -167,15 +171,19 @@ void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums) {
   for (size_t j = 0; j < kCandidates; ++j) m[j] += sums.a[j] * sums.a[j] + sums.d[j];
 }
 
+void add_counts(ProbeWork& total, const ProbeWork& w) {
+  total.light_paths += w.light_paths;
+  total.light_vertices += w.light_vertices;
+  total.camera_vertices += w.camera_vertices;
+  total.nondelta_camera_vertices += w.nondelta_camera_vertices;
+  total.connections += w.connections;
+  total.merge_queries += w.merge_queries;
+  total.photons += w.photons;
+}
+
 void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means) {
   ++probes_;
-  work_.light_paths += w.light_paths;
-  work_.light_vertices += w.light_vertices;
-  work_.camera_vertices += w.camera_vertices;
-  work_.nondelta_camera_vertices += w.nondelta_camera_vertices;
-  work_.connections += w.connections;
-  work_.merge_queries += w.merge_queries;
-  work_.photons += w.photons;
+  add_counts(work_, w);
   work_.light_seconds += w.light_seconds;
   work_.camera_seconds += w.camera_seconds;
   work_.connect_seconds += w.connect_seconds;

@@ -58,6 +58,9 @@ struct ProbeWork {
   double light_seconds = 0, camera_seconds = 0, connect_seconds = 0, merge_seconds = 0;
 };
 
+// Adds w's operation counts (not its seconds) to total.
+void add_counts(ProbeWork& total, const ProbeWork& w);
+
 class AdaptivePlan {
  public:
   AdaptivePlan() = default;

@@ -33,12 +33,12 @@ Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pc
   if (it.plan.probe) {
     plan_.pixel_end(sample.pixel, acc.candidate_sums);
     if (settings_.bidir.measured_costs) acc.work.camera_seconds = seconds_since(start);
-    add_probe_work(acc.work);
   }
+  add_work(acc.work);
   return acc.sum;
 }
 
-void BidirIntegrator::add_probe_work(const ProbeWork& w) const {
+void BidirIntegrator::add_work(const ProbeWork& w) const {
   std::lock_guard<std::mutex> lock(probe_mutex_);
   probe_.camera_vertices += w.camera_vertices;
   probe_.nondelta_camera_vertices += w.nondelta_camera_vertices;

@@ -168,7 +168,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
   Rgb estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng, ScratchArena& arena,
                uint64_t* nonfinite) const override;
 
-  void add_probe_work(const ProbeWork& w) const;
+  // A pixel's work, into this iteration's (probe_).
+  void add_work(const ProbeWork& w) const;
 
   void camera_path(const Scene& scene, const Iteration& it, const CameraSample& sample, Pcg32& rng,
                    PixelAccumulator& acc, ScratchArena& arena) const;
@@ -250,13 +251,15 @@ class BidirIntegrator final : public CameraPathIntegrator {
   uint32_t iterations_ = 0;
   uint64_t vertices_total_ = 0;
   double seconds_total_ = 0;
-  double grid_seconds_total_ = 0;   // of seconds_total_, building the hash grid
-  double light_seconds_total_ = 0;  // of seconds_total_, tracing light paths (with their splats)
+  double grid_seconds_total_ = 0;    // of seconds_total_, building the hash grid
+  double light_seconds_total_ = 0;   // of seconds_total_, tracing light paths (with their splats)
+  double camera_seconds_total_ = 0;  // of seconds_total_, tracing camera paths
+  ProbeWork work_total_;             // operations counted over all iterations (counts only)
   std::vector<std::string> technique_files_;
 
   // adaptive-vcm: the plan, and the work of the current probe iteration.
   mutable AdaptivePlan plan_;
-  mutable ProbeWork probe_;
+  mutable ProbeWork probe_;  // this iteration's work
   mutable std::mutex probe_mutex_;
 };
 

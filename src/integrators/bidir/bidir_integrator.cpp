@@ -120,9 +120,10 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   current_ = it;
   const auto camera_start = std::chrono::steady_clock::now();
   trace_camera_paths(scene, iteration, film);
+  camera_seconds_total_ += seconds_since(camera_start);
+  probe_.light_vertices = double(vertices_.size());
+  add_counts(work_total_, probe_);
   if (it.plan.probe) {
-    probe_.light_vertices = double(vertices_.size());
-    probe_.light_seconds = 0;
     probe_.light_seconds = light_chunk_seconds_;
     if (probe_.light_seconds == 0) probe_.light_seconds = light_seconds;
     if (probe_.camera_seconds == 0) probe_.camera_seconds = seconds_since(camera_start);
@@ -158,6 +159,18 @@ void BidirIntegrator::report(nlohmann::json& stats) const {
   b["radius_alpha"] = settings_.bidir.radius_alpha;
   b["ms_per_iteration"] = iterations_ ? 1e3 * seconds_total_ / iterations_ : 0.0;
   b["light_paths_ms_per_iteration"] = iterations_ ? 1e3 * light_seconds_total_ / iterations_ : 0.0;
+  b["camera_paths_ms_per_iteration"] =
+      iterations_ ? 1e3 * camera_seconds_total_ / iterations_ : 0.0;
+  // What an iteration did on average: the counts the cost model of adaptive-vcm prices.
+  const double per = iterations_ ? 1.0 / iterations_ : 0.0;
+  b["work_per_iteration"] = {
+      {"light_paths", work_total_.light_paths * per},
+      {"light_vertices", work_total_.light_vertices * per},
+      {"camera_vertices", work_total_.camera_vertices * per},
+      {"nondelta_camera_vertices", work_total_.nondelta_camera_vertices * per},
+      {"connections", work_total_.connections * per},
+      {"merge_queries", work_total_.merge_queries * per},
+      {"photons", work_total_.photons * per}};
   if (!technique_files_.empty()) b["technique_images"] = technique_files_;
   stats["bidir"] = b;
 }

@@ -31,6 +31,7 @@ struct CostModel {
 constexpr float kLightPathFactors[] = {0.25f, 0.5f, 1.f, 2.f};
 constexpr int kConnections[] = {0, 1, 2, 4};
 constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
+constexpr int kBlurRadius = 3;        // pixel variances pooled over 7 x 7 (box_blur)
 constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
 constexpr int kFirstProbes = 4;
 
@@ -53,6 +54,27 @@ CostModel costs_of(const ProbeWork& w, bool measured) {
     t.photon *= scale;
   }
   return t;
+}
+
+// Separable box filter of the given radius (clamped at the borders): a pixel's variance estimate
+// rests on a handful of probe samples; choosing per pixel between two such estimates picks the
+// luckier one (a caustic pixel whose probes missed the caustic stops merging). Neighbours share
+// their light transport, so their estimates are pooled.
+std::vector<double> box_blur(const std::vector<double>& in, int w, int h, int r) {
+  std::vector<double> tmp(in.size()), out(in.size());
+  auto pass = [r](const double* src, double* dst, int n, int stride) {
+    double sum = 0;
+    int count = 0;
+    for (int i = 0; i < std::min(r, n); ++i) sum += src[size_t(i) * stride], ++count;
+    for (int i = 0; i < n; ++i) {
+      if (i + r < n) sum += src[size_t(i + r) * stride], ++count;
+      if (i - r - 1 >= 0) sum -= src[size_t(i - r - 1) * stride], --count;
+      dst[size_t(i) * stride] = sum / count;
+    }
+  };
+  for (int y = 0; y < h; ++y) pass(&in[size_t(y) * w], &tmp[size_t(y) * w], w, 1);
+  for (int x = 0; x < w; ++x) pass(&tmp[x], &out[x], h, w);
+  return out;
 }
 
 // Per pixel and iteration, from the probes' work (light paths at one per pixel).
@@ -208,7 +230,7 @@ std::vector<double> AdaptivePlan::relative_variances(size_t j,
   std::nth_element(sorted.begin(), sorted.begin() + q, sorted.end());
   const double cap = sorted[q];
   for (double& x : v) x = std::min(x, cap);
-  return v;
+  return box_blur(v, width_, height_, kBlurRadius);
 }
 
 void AdaptivePlan::choose(const std::vector<float>& means) {

@@ -22,7 +22,9 @@
 //
 // Probes are iterations 0 to 3, then 7, 15, 31, ... (2^k - 1): their cost fades as the render
 // grows. The first choice is made after the fourth probe; the pixels' relative variances are
-// winsorised at their 99.5th percentile (a firefly all candidates share must not decide).
+// winsorised at their 99.5th percentile (a firefly all candidates share must not decide) and
+// pooled over 7 x 7 neighbours before the per-pixel merge decision (a handful of samples per
+// pixel would otherwise decide by luck).
 // Every iteration, probe or not, is an unbiased (consistent, when merging) estimate of the
 // same image, and the film averages them. Deterministic at fixed spp and seed for any thread
 // count unless measured costs are asked for; one process only (learns while rendering).
@@ -110,7 +112,7 @@ class AdaptivePlan {
   static const std::vector<Candidate>& candidates();
 
  private:
-  // Per pixel: the relative variance per iteration of candidate j, winsorised.
+  // Per pixel: the relative variance per iteration of candidate j, winsorised and pooled.
   std::vector<double> relative_variances(size_t j, const std::vector<float>& means) const;
   void choose(const std::vector<float>& means);
 

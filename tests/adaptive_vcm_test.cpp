@@ -108,3 +108,36 @@ TEST(AdaptiveVcm, PredictedVarianceMatchesRenderingTheConfiguration) {
     EXPECT_NEAR(prediction / measured, 1.0, 0.15) << c.integrator << " " << c.factor;
   }
 }
+
+// On the Cornell box with a glass sphere under a small area light, path tracing alone renders
+// the caustic with huge variance: adaptive-vcm keeps light paths and merges where the caustic
+// is; the report carries the choice, its history and the merge mask.
+TEST(AdaptiveVcm, KeepsMergingForCausticsAndReportsWhy) {
+  auto scene = make_builtin_scene("cornell-glass", 48, 48);
+  IntegratorSettings s;
+  s.max_depth = 8;
+  auto in = make_integrator("adaptive-vcm", s);
+  Film film(48, 48);
+  in->prepare(*scene, film);
+  for (uint32_t i = 0; i < 16; ++i) {
+    in->render_iteration(*scene, i, film);
+    film.end_iteration();
+  }
+  nlohmann::json stats;
+  in->report(stats);
+  const auto& a = stats["adaptive"];
+  ASSERT_FALSE(a["history"].empty());
+  EXPECT_EQ(a["probes"].get<int>(), 6);  // iterations 0-3, 7, 15
+  EXPECT_GT(a["light_paths_per_iteration"].get<uint64_t>(), 0u);
+  EXPECT_GT(a["merge_fraction"].get<double>(), 0.02);
+  EXPECT_LT(a["merge_fraction"].get<double>(), 1.0);
+  const auto& mask = a["merge_mask"];
+  EXPECT_EQ(mask["width"].get<int>() * mask["block"].get<int>(), 48);
+  EXPECT_EQ(mask["fraction"].size(), size_t(mask["width"].get<int>() * mask["height"].get<int>()));
+  // The candidate table prices path tracing far worse than what was chosen.
+  const auto& table = a["history"].back()["candidates"];
+  EXPECT_EQ(table[0]["light_path_factor"].get<double>(), 0.0);
+  double best = 1e300;
+  for (const auto& c : table) best = std::min(best, c["score"].get<double>());
+  EXPECT_GT(table[0]["score"].get<double>(), 2 * best);
+}

@@ -146,37 +146,51 @@ IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
   return p;
 }
 
-void AdaptivePlan::begin_probe() { light_sums_.assign(pixels_ * kCandidates, 0.f); }
+void AdaptivePlan::begin_probe(float radius) {
+  light_sums_.assign(pixels_ * kCandidates, 0.f);
+  const std::vector<Candidate>& list = candidates();
+  for (size_t j = 0; j < kCandidates; ++j) {
+    const MisCounts n = counts_of(list[j], pixels_, radius);
+    // The emitter class always counts 1 (counts_of): it is added unscaled in add().
+    table_.light_trace[j] = n.light_trace;
+    table_.connect[j] = n.connect;
+    table_.merge[j] = n.merge;
+    table_.emitter[j] = n.emitter;
+  }
+}
 
 void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* terms,
-                       const MisCounts& counts, float radius) const {
+                       const MisCounts& counts) const {
   if (!(value != 0.f) || !std::isfinite(value)) return;
   if (!terms) {
     for (size_t j = 0; j < kCandidates; ++j) sums.a[j] += value;
     return;
   }
+  // The probe's counts are all positive, so a finite Q means finite terms: plain arithmetic.
   const float q = terms->denominator(counts), own = counts.of(terms->own);
   if (!(q > 0) || !std::isfinite(q) || !(own > 0)) return;
-  const std::vector<Candidate>& list = candidates();
+  const std::array<float, kCandidates>& own_count = table_.of(terms->own);
+  const float f2 = value * value, inv_own = 1.f / own;
   for (size_t j = 0; j < kCandidates; ++j) {
-    const MisCounts n = counts_of(list[j], pixels_, radius);
-    const float q_candidate = terms->denominator(n);
+    const float q_candidate = own_count[j] + terms->emitter +
+                              table_.light_trace[j] * terms->light_trace +
+                              table_.connect[j] * terms->connect + table_.merge[j] * terms->merge;
+    // No technique of the candidate makes this path: it would miss the energy.
     if (!(q_candidate > 0)) {
-      // No technique of the candidate makes this path: it would miss the energy.
       sums.d[j] = std::numeric_limits<float>::infinity();
       continue;
     }
     const float ratio = q / q_candidate;
-    const float g = value * ratio * (n.of(terms->own) / own);
+    const float g = value * ratio * (own_count[j] * inv_own);
     sums.a[j] += g;
-    sums.d[j] += value * value * ratio - g * g;
+    sums.d[j] += f2 * ratio - g * g;
   }
 }
 
 void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTerms* terms,
-                                   const MisCounts& counts, float radius) {
+                                   const MisCounts& counts) {
   CandidateSums sums = pixel_start(pixel);
-  add(sums, value, terms, counts, radius);
+  add(sums, value, terms, counts);
   std::copy(sums.a.begin(), sums.a.end(), light_sums_.begin() + pixel * kCandidates);
   float* m = &moments_[pixel * kCandidates];
   for (size_t j = 0; j < kCandidates; ++j) m[j] += sums.d[j];

@@ -86,12 +86,13 @@ class AdaptivePlan {
   struct CandidateSums {
     std::array<float, kCandidates> a{}, d{};
   };
-  void begin_probe();
+  // radius: the probe's merge radius (the candidates' merge counts N' pi r^2).
+  void begin_probe(float radius);
   // terms == nullptr: a path only one technique makes (the same F under every candidate).
-  void add(CandidateSums& sums, float value, const TechniqueTerms* terms, const MisCounts& counts,
-           float radius) const;
+  void add(CandidateSums& sums, float value, const TechniqueTerms* terms,
+           const MisCounts& counts) const;
   void add_light_trace(size_t pixel, float value, const TechniqueTerms* terms,
-                       const MisCounts& counts, float radius);
+                       const MisCounts& counts);
   CandidateSums pixel_start(size_t pixel) const;
   void pixel_end(size_t pixel, const CandidateSums& sums);
   // After a probe: its work, and the pixel means of the iterations before it (empty after the
@@ -122,6 +123,16 @@ class AdaptivePlan {
   bool probe_all_ = false;
   std::vector<float> moments_;     // pixels x candidates: sum over probes of A^2 + D
   std::vector<float> light_sums_;  // pixels x candidates: this probe's light-tracing A
+  // The candidates' counts per class for this probe's radius (structure of arrays).
+  struct CountTable {
+    std::array<float, kCandidates> emitter{}, light_trace{}, connect{}, merge{};
+    const std::array<float, kCandidates>& of(TechniqueClass c) const {
+      return c == TechniqueClass::Emitter      ? emitter
+             : c == TechniqueClass::LightTrace ? light_trace
+             : c == TechniqueClass::Connect    ? connect
+                                               : merge;
+    }
+  } table_;
   int probes_ = 0;
   ProbeWork work_;  // summed over probes
   std::vector<uint8_t> merge_mask_;

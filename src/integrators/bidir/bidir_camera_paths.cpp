@@ -24,7 +24,6 @@ Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pc
   acc.rules = it.plan.merges(sample.pixel) ? &it.rules : &it.rules_no_merge;
   if (it.plan.probe) {
     acc.plan = &plan_;
-    acc.radius = it.radius;
     acc.candidate_sums = plan_.pixel_start(sample.pixel);
   }
   const auto start = std::chrono::steady_clock::now();

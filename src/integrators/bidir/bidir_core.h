@@ -87,7 +87,6 @@ struct PixelAccumulator {
   AdaptivePlan* plan = nullptr;
   AdaptivePlan::CandidateSums candidate_sums;
   const MisRules* rules = nullptr;
-  float radius = 0;
   ProbeWork work;
   // sum is the estimate before the filter weight (the seam applies it); technique images get
   // each value already weighted, so that they add up to the image. terms: the value's MIS
@@ -100,8 +99,7 @@ struct PixelAccumulator {
     sum += value;
     if (techniques)
       techniques->add(TechniqueImages::key(merge, s, t), pixel, value * filter_weight);
-    if (plan)
-      plan->add(candidate_sums, scalar(value * filter_weight), terms, rules->counts(), radius);
+    if (plan) plan->add(candidate_sums, scalar(value * filter_weight), terms, rules->counts());
   }
 };
 

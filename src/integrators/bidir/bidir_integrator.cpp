@@ -99,7 +99,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
       LightPathAssignment(film.pixel_count(), std::max<uint64_t>(n, 1), iteration, settings_.seed);
   probe_ = {};
   probe_.light_paths = double(n);
-  if (it.plan.probe) plan_.begin_probe();
+  if (it.plan.probe) plan_.begin_probe(it.radius);
   // Before this iteration adds anything: the film adds estimates to its totals as they come.
   const std::vector<float> means_before = it.plan.probe ? pixel_means(film) : std::vector<float>();
 

@@ -119,8 +119,7 @@ void BidirIntegrator::append_chunk(const Iteration& it, const LightChunk& chunk)
     splat_image_[s.pixel] += s.value;
     if (techniques_.enabled()) techniques_.add(s.technique, s.pixel, s.value);
     if (it.plan.probe)
-      plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[i], it.rules.counts(),
-                            it.radius);
+      plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[i], it.rules.counts());
   }
 }
 

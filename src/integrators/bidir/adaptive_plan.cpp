@@ -33,7 +33,7 @@ constexpr int kConnections[] = {0, 1, 2, 4};
 constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
 constexpr int kBlurRadius = 3;        // pixel variances pooled over 7 x 7 (box_blur)
 constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
-constexpr int kFirstProbes = 4;
+constexpr int kFirstProbes = 2;
 
 // The operation costs: the model, or what the probes measured (seconds summed over threads).
 CostModel costs_of(const ProbeWork& w, bool measured) {
@@ -128,7 +128,7 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
 }
 
 bool AdaptivePlan::is_probe(uint32_t iteration) const {
-  // 0, 1, 2, 3, then 7, 15, 31, ...
+  // 0, 1, 3, 7, 15, 31, ...
   return probe_all_ || iteration < kFirstProbes || std::has_single_bit(uint64_t(iteration) + 1);
 }
 
@@ -224,7 +224,7 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   work_.camera_seconds += w.camera_seconds;
   work_.connect_seconds += w.connect_seconds;
   work_.merge_seconds += w.merge_seconds;
-  // A choice needs the film's means and a few probes: one or two are mostly noise.
+  // A choice needs the film's means (from the iterations before the probe) and two probes.
   if (means.size() == pixels_ && (probes_ >= kFirstProbes || probe_all_)) choose(means);
 }
 

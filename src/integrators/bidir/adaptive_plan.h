@@ -20,8 +20,8 @@
 // (light paths, connections) the merge mask takes, per pixel, the option of lower
 // variance x (pixel cost); then the global pair of lowest total wins.
 //
-// Probes are iterations 0 to 3, then 7, 15, 31, ... (2^k - 1): their cost fades as the render
-// grows. The first choice is made after the fourth probe; the pixels' relative variances are
+// Probes are iterations 0, 1, 3, 7, 15, 31, ... (2^k - 1): their cost fades as the render
+// grows. The first choice is made after the second probe; the pixels' relative variances are
 // winsorised at their 99.5th percentile (a firefly all candidates share must not decide) and
 // pooled over 7 x 7 neighbours before the per-pixel merge decision (a handful of samples per
 // pixel would otherwise decide by luck).

@@ -79,14 +79,16 @@ std::vector<double> box_blur(const std::vector<double>& in, int w, int h, int r)
 
 // Per pixel and iteration, from the probes' work (light paths at one per pixel).
 struct PixelWork {
-  double camera_vertices, nondelta, light_vertices_per_path, merge_queries, photons;
+  // connections: light vertices connected per pixel with one connection per camera vertex
+  // (the probes': depth limits and early rejections make it far fewer than vertices x vertices).
+  double camera_vertices, connections, light_vertices_per_path, merge_queries, photons;
 };
 
 double base_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
   double cost = w.camera_vertices * t.camera_vertex;
   if (c.light_path_factor > 0)
     cost += c.light_path_factor * w.light_vertices_per_path * t.light_vertex +
-            w.nondelta * c.connections * w.light_vertices_per_path * t.connection;
+            c.connections * w.connections * t.connection;
   return cost;
 }
 
@@ -228,22 +230,36 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   if (means.size() == pixels_ && (probes_ >= kFirstProbes || probe_all_)) choose(means);
 }
 
-std::vector<double> AdaptivePlan::relative_variances(size_t j,
-                                                     const std::vector<float>& means) const {
-  const double probes = double(probes_);
-  std::vector<double> v(pixels_);
+double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means) const {
+  const double mean = means[p], moment = moments_[p * kCandidates + j] / double(probes_);
+  return std::max(moment - mean * mean, 0.0) / (mean * mean + kRelEps);
+}
+
+std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<float>& means) const {
+  // The part of a pixel's variance every candidate has (the least of them) is winsorised at its
+  // 99.5th percentile over the pixels: a firefly that a few probes saw in a handful of pixels,
+  // and that every candidate shares, is mostly estimation noise; at full weight it drowns the
+  // differences everywhere else and lets the cheapest candidate win. What a candidate has beyond
+  // the least (its own fireflies: missing connections, fewer light paths) is kept in full.
+  std::vector<double> shared(pixels_);
   for (size_t p = 0; p < pixels_; ++p) {
-    const double mean = means[p], moment = moments_[p * kCandidates + j] / probes;
-    v[p] = std::max(moment - mean * mean, 0.0) / (mean * mean + kRelEps);
+    double least = std::numeric_limits<double>::infinity();
+    for (size_t j = 0; j < kCandidates; ++j)
+      least = std::min(least, relative_variance(p, j, means));
+    shared[p] = least;
   }
-  // Winsorised at the 99.5th percentile: a firefly that a few probes saw in a handful of pixels
-  // (and that every candidate shares) is mostly estimation noise; at full weight it drowns the
-  // differences everywhere else and lets the cheapest candidate win.
-  std::vector<double> sorted = v;
+  std::vector<double> sorted = shared;
   const size_t q = std::min(pixels_ - 1, size_t(double(pixels_) * kWinsorize));
   std::nth_element(sorted.begin(), sorted.begin() + q, sorted.end());
   const double cap = sorted[q];
-  for (double& x : v) x = std::min(x, cap);
+  for (double& x : shared) x = x > cap ? cap - x : 0.0;
+  return shared;
+}
+
+std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector<float>& means,
+                                                     const std::vector<double>& correction) const {
+  std::vector<double> v(pixels_);
+  for (size_t p = 0; p < pixels_; ++p) v[p] = relative_variance(p, j, means) + correction[p];
   return box_blur(v, width_, height_, kBlurRadius);
 }
 
@@ -252,11 +268,12 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   const size_t k = list.size();
   const double probes = double(probes_), pixels = double(pixels_);
   const PixelWork pw{work_.camera_vertices / (probes * pixels),
-                     work_.nondelta_camera_vertices / (probes * pixels),
+                     work_.connections / (probes * pixels),
                      work_.light_paths > 0 ? work_.light_vertices / work_.light_paths : 0.0,
                      work_.merge_queries / (probes * pixels), work_.photons / (probes * pixels)};
   const CostModel t = costs_of(work_, measured_);
-  const std::vector<double> pt = relative_variances(0, means);
+  const std::vector<double> correction = shared_firefly_correction(means);
+  const std::vector<double> pt = relative_variances(0, means, correction);
   double best = std::numeric_limits<double>::infinity();
   size_t best_j = 0;
   std::vector<uint8_t> mask(pixels_), best_mask(pixels_, 0);
@@ -266,8 +283,8 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     const Candidate& c = list[j];
     const double cost = base_cost(c, pw, t);
     const double extra = j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t);
-    const std::vector<double> no_merge = j == 0 ? pt : relative_variances(j, means);
-    const std::vector<double> merge = j == 0 ? pt : relative_variances(j + 1, means);
+    const std::vector<double> no_merge = j == 0 ? pt : relative_variances(j, means, correction);
+    const std::vector<double> merge = j == 0 ? pt : relative_variances(j + 1, means, correction);
     double variance = 0, total_cost = 0, variance0 = 0, variance1 = 0;
     for (size_t p = 0; p < pixels_; ++p) {
       const double v0 = no_merge[p], v1 = merge[p];

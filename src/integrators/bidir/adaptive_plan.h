@@ -21,8 +21,8 @@
 // variance x (pixel cost); then the global pair of lowest total wins.
 //
 // Probes are iterations 0, 1, 3, 7, 15, 31, ... (2^k - 1): their cost fades as the render
-// grows. The first choice is made after the second probe; the pixels' relative variances are
-// winsorised at their 99.5th percentile (a firefly all candidates share must not decide) and
+// grows. The first choice is made after the second probe; the variance all candidates share
+// is winsorised at its 99.5th percentile over the pixels (a shared firefly must not decide) and
 // pooled over 7 x 7 neighbours before the per-pixel merge decision (a handful of samples per
 // pixel would otherwise decide by luck).
 // Every iteration, probe or not, is an unbiased (consistent, when merging) estimate of the
@@ -113,8 +113,13 @@ class AdaptivePlan {
   static const std::vector<Candidate>& candidates();
 
  private:
-  // Per pixel: the relative variance per iteration of candidate j, winsorised and pooled.
-  std::vector<double> relative_variances(size_t j, const std::vector<float>& means) const;
+  // Pixel p's relative variance per iteration under candidate j.
+  double relative_variance(size_t p, size_t j, const std::vector<float>& means) const;
+  // Per pixel: what to add to every candidate's variance to winsorise the part they share.
+  std::vector<double> shared_firefly_correction(const std::vector<float>& means) const;
+  // Per pixel: candidate j's relative variance, corrected and pooled over neighbours.
+  std::vector<double> relative_variances(size_t j, const std::vector<float>& means,
+                                         const std::vector<double>& correction) const;
   void choose(const std::vector<float>& means);
 
   size_t pixels_ = 0;

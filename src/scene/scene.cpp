@@ -87,6 +87,11 @@ void embree_error(void* user, RTCError, const char* str) {
   if (message->empty()) *message = str ? str : "unknown error";
 }
 
+bool embree_memory(void* user, ssize_t bytes, bool) {
+  *static_cast<std::atomic<int64_t>*>(user) += int64_t(bytes);
+  return true;
+}
+
 }  // namespace
 
 namespace {
@@ -190,6 +195,7 @@ void Scene::build_accelerator() {
   im.device = rtcNewDevice(nullptr);
   if (!im.device) throw std::runtime_error("could not create the Embree device");
   rtcSetDeviceErrorFunction(im.device, embree_error, &im.error);
+  rtcSetDeviceMemoryMonitorFunction(im.device, embree_memory, &im.embree_bytes);
   // Build every BVH on one thread: its layout, and so the choice between equally close hits
   // (shared edges), is then the same for any thread count, keeping images bit-identical.
   tbb::task_arena single_threaded(1);
@@ -288,6 +294,23 @@ size_t Scene::stored_triangle_count() const {
   for (const SceneData::Prototype& proto : prototypes_)
     for (const auto& m : proto.meshes) n += m.mesh.triangle_count();
   return n;
+}
+
+static size_t mesh_bytes(const std::vector<SceneData::MeshEntry>& meshes) {
+  size_t n = meshes.capacity() * sizeof(SceneData::MeshEntry);
+  for (const auto& e : meshes) {
+    const TriangleMesh& m = e.mesh;
+    n += m.positions.capacity() * sizeof(Vec3) + m.normals.capacity() * sizeof(Vec3) +
+         m.uvs.capacity() * sizeof(Vec2) + m.indices.capacity() * sizeof(uint32_t);
+  }
+  return n;
+}
+
+size_t Scene::geometry_bytes() const {
+  size_t n = mesh_bytes(meshes_) + spheres_.capacity() * sizeof(SceneData::SphereEntry) +
+             instances_.capacity() * sizeof(SceneData::InstanceEntry);
+  for (const SceneData::Prototype& proto : prototypes_) n += mesh_bytes(proto.meshes);
+  return n + size_t(std::max<int64_t>(impl_->embree_bytes.load(), 0));
 }
 
 uint64_t Scene::rays_traced() const {

@@ -87,6 +87,9 @@ class Scene {
   size_t stored_triangle_count() const;
   size_t sphere_count() const { return spheres_.size(); }
   size_t instance_count() const { return instances_.size(); }
+  // Bytes the geometry holds: the meshes' arrays (each prototype's once), the instances, and
+  // Embree's buffers and BVHs as its memory monitor counts them.
+  size_t geometry_bytes() const;
 
   // Rays traced through intersect/occluded since construction (all threads), and how many of
   // them were occlusion rays (the bench weighs the raw Embree bound by this mix).

@@ -5,6 +5,7 @@
 #include <embree3/rtcore.h>
 #include <tbb/enumerable_thread_specific.h>
 
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,7 @@ struct Scene::Impl {
     uint64_t all = 0, occlusion = 0;
   };
   mutable tbb::enumerable_thread_specific<RayCounts> rays;
+  std::atomic<int64_t> embree_bytes{0};  // what Embree's memory monitor reports it holds
   std::string error;
 
   ~Impl() {

@@ -39,11 +39,7 @@ Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pc
 
 void BidirIntegrator::add_work(const ProbeWork& w) const {
   std::lock_guard<std::mutex> lock(probe_mutex_);
-  probe_.camera_vertices += w.camera_vertices;
-  probe_.nondelta_camera_vertices += w.nondelta_camera_vertices;
-  probe_.connections += w.connections;
-  probe_.merge_queries += w.merge_queries;
-  probe_.photons += w.photons;
+  add_counts(probe_, w);  // a pixel's work has no light paths or light vertices
   probe_.camera_seconds += w.camera_seconds;
   probe_.connect_seconds += w.connect_seconds;
   probe_.merge_seconds += w.merge_seconds;

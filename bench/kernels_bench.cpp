@@ -4,9 +4,11 @@
 //   --benchmark_repetitions=5
 // Google Benchmark prints the machine (CPUs, caches, load) with the results; report medians.
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
 #include "core/rng.h"
 #include "core/warp.h"
+#include "integrators/bidir/hash_grid.h"
 #include "io/builtin_scenes.h"
 #include "lights/light.h"
 #include "lights/light_sampler.h"
@@ -105,8 +107,55 @@ void BM_IntersectIncoherent(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 
+// About as many light vertices as one iteration of vcm on cornell-glass 512x512 (550k), spread
+// over the faces of a box of the same size, and its merge radius.
+const std::vector<bidir::LightVertex>& box_photons() {
+  static const std::vector<bidir::LightVertex> vertices = [] {
+    std::vector<bidir::LightVertex> v(550000);
+    Pcg32 rng(5, 5);
+    for (bidir::LightVertex& x : v) {
+      const int face = int(rng.next_float() * 6) % 6;
+      const Vec2 u = rng.next_2d();
+      float p[3] = {2 * u.x - 1, 2 * u.y - 1, 2 * u.x - 1};
+      p[face % 3] = face < 3 ? -1.f : 1.f;
+      p[(face + 1) % 3] = 2 * u.x - 1;
+      p[(face + 2) % 3] = 2 * u.y - 1;
+      x = {};
+      for (int a = 0; a < 3; ++a) x.position[a] = p[a];
+    }
+    return v;
+  }();
+  return vertices;
+}
+constexpr float kBoxMergeRadius = 0.0067f;
+
+// Argument: threads.
+void BM_HashGridBuild(benchmark::State& state) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(state.range(0)));
+  const auto& vertices = box_photons();
+  bidir::HashGrid grid;
+  for (auto _ : state) grid.build(vertices, kBoxMergeRadius);
+  state.SetItemsProcessed(state.iterations() * int64_t(vertices.size()));
+}
+
+void BM_HashGridQuery(benchmark::State& state) {
+  const auto& vertices = box_photons();
+  bidir::HashGrid grid;
+  grid.build(vertices, kBoxMergeRadius);
+  Pcg32 rng(6, 6);
+  for (auto _ : state) {
+    float sum = 0;
+    const Vec3 p = vertices[size_t(rng.next_float() * float(vertices.size()))].p();
+    grid.for_each_near(p, vertices, [&](uint32_t, Vec3 q) { sum += q.x; });
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
 }  // namespace
 
+BENCHMARK(BM_HashGridBuild)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_HashGridQuery);
 BENCHMARK(BM_DiffuseSample);
 BENCHMARK(BM_RoughConductorSample);
 BENCHMARK(BM_DielectricSample);

@@ -65,9 +65,18 @@ IntegratorSettings integrator_settings(const LoadedScene& s, uint64_t seed,
       settings.bidir.radius = float(number_arg(name, value, 0, 1e12, true));
     } else if (name == "radius_alpha") {
       settings.bidir.radius_alpha = float(number_arg(name, value, 0, 1, true));
+    } else if (name == "connections") {
+      settings.bidir.connections = int(integer_arg(name, value, 1, 64));
+    } else if (name == "adaptive_costs") {
+      const std::string c = py::isinstance<py::str>(value) ? value.cast<std::string>() : "";
+      if (c != "model" && c != "measured")
+        throw py::value_error("adaptive_costs must be one of model, measured, got " +
+                              std::string(py::repr(value)));
+      settings.bidir.measured_costs = c == "measured";
     } else {
       throw py::value_error("unknown option '" + name +
-                            "'; valid: mis, max_depth, light_paths, radius, radius_alpha");
+                            "'; valid: mis, max_depth, light_paths, radius, radius_alpha, "
+                            "connections, adaptive_costs");
     }
   }
   const Camera& camera = s.scene->camera();
@@ -238,7 +247,9 @@ void add_render_functions(py::module_& m) {
         "balance for the bidirectional family), max_depth (0..255; default: the scene's), "
         "light_paths (light subpaths per iteration, >= 1; default: one per pixel), radius "
         "(initial merge radius, > 0; default: from the scene size), radius_alpha (in (0, 1]; "
-        "default 0.75). None means not given. Unknown names or bad values raise ValueError.\n"
+        "default 0.75), connections (light subpaths per camera vertex for bpt/vcm, 1..64), "
+        "adaptive_costs ('model' or 'measured', adaptive-vcm). None means not given. Unknown names "
+        "or bad values raise ValueError.\n"
         "Releases the GIL; Ctrl-C ends the render after its current iteration and raises "
         "KeyboardInterrupt.");
 

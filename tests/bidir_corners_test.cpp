@@ -216,18 +216,20 @@ TEST(BidirHashGrid, FindsNeighboursFarFromTheOrigin) {
 TEST(BidirMisLimits, ZeroTimesInfiniteSumIsTheLimitNotAZeroWeight) {
   const bidir::MisRules rules(MisHeuristic::Balance, true, false, 100.f, 0.f);
   const float inf = std::numeric_limits<float>::infinity();
-  const bidir::MisSums light{inf, 2.f, 0.f}, camera{0.5f, 0.25f, 0.f};
+  // Both vertices beyond their subpath's first: dVCM stands for a connection (count 1).
+  const bidir::MisSums light{inf, 0.f, 2.f, 0.f, false}, camera{0.5f, 0.f, 0.25f, 0.f, false};
   // The camera side cannot sample the light vertex (pdf 0): w_light = 0; w_camera finite.
-  const float w = rules.connect(light, camera, /*camera_pdf_a=*/0.f, 1.f, /*light_pdf_a=*/2.f, 1.f);
+  const float w = rules.connect(light, camera, /*camera_pdf_a=*/0.f, 1.f, /*light_pdf_a=*/2.f, 1.f)
+                      .weight(rules.counts());
   const float w_camera = 2.f * (0.5f + 0.25f * 1.f);
   EXPECT_FLOAT_EQ(w, 1.f / (1.f + w_camera));
   // Sums reaching a grazing vertex: 0 * (1 / cos 0) stays 0, not NaN.
-  bidir::MisSums s{0.f, 0.f, 0.f};
+  bidir::MisSums s;
   rules.hit(s, 1.f, 0.f);
   EXPECT_EQ(s.vcm, 0.f);
-  EXPECT_EQ(s.vc, 0.f);
+  EXPECT_EQ(s.conn, 0.f);
   // A genuinely infinite sum of other techniques gives the current one weight 0.
-  EXPECT_EQ(rules.connect(light, camera, 1.f, 1.f, 2.f, 1.f), 0.f);
+  EXPECT_EQ(rules.connect(light, camera, 1.f, 1.f, 2.f, 1.f).weight(rules.counts()), 0.f);
 }
 
 // --- 6. Light paths fewer than pixels -----------------------------------------------------------

@@ -160,9 +160,11 @@ struct Key {
 // The oracle: every technique's path pdf as an explicit product of area densities, in double.
 // Conventions shared with the renderer (mis.h): geometric cosines, delta bounces have pdf 1 in
 // both directions, no Russian roulette, n = N for light tracing, merges multiply by N pi r^2.
+// connections: the count of each connection technique (s, t >= 2).
 std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& path, bool connect,
                                      bool merge, bool power, double light_paths, double radius,
-                                     ScratchArena& arena, double raster_density = 1) {
+                                     ScratchArena& arena, double raster_density = 1,
+                                     double connections = 1) {
   const Light& light = *path.light;
   const bool finite = !light.is_infinite();
   const double pmf = scene.light_sampler().pmf(&light);
@@ -224,7 +226,8 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
   if (connect && !delta(1)) p[{false, 1, k}] = nee_pdf * prod(camera_pdf, 1, k - 1);
   for (int s = 2; connect && s <= k - 1; ++s)
     if (!delta(s - 1) && !delta(s))
-      p[{false, s, k + 1 - s}] = prod(light_pdf, 0, s - 1) * prod(camera_pdf, s, k - 1);
+      p[{false, s, k + 1 - s}] =
+          connections * prod(light_pdf, 0, s - 1) * prod(camera_pdf, s, k - 1);
   if (connect && !delta(k - 1)) p[{false, k, 1}] = light_paths * prod(light_pdf, 0, k - 1);
   for (int j = 1; merge && j <= k - 1; ++j)
     if (!delta(j))
@@ -244,6 +247,8 @@ struct Case {
   BidirAlgorithm algorithm;
   MisHeuristic heuristic;
   float light_paths = 1024;  // N; the scenes have 32 x 32 pixels (corners: 40 x 28)
+  int connections = 1;       // per camera vertex
+  bool pixel_merges = true;  // false: a pixel of adaptive-vcm that does not merge
 };
 
 // With filter_densities, each path is weighted for a pixel whose filter has a random raster
@@ -254,7 +259,7 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
   ScratchArena arena;
   const float light_paths = c.light_paths, radius = 0.02f;
   const bool connect = c.algorithm != BidirAlgorithm::Bpm,
-             merge = c.algorithm != BidirAlgorithm::Bpt;
+             merge = c.algorithm != BidirAlgorithm::Bpt && c.pixel_merges;
   int checked = 0, attempts = 0, with_delta = 0;
   double worst_sum = 0, worst_oracle = 0;
   ExplicitPath path;
@@ -264,10 +269,10 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
     if (!random_path(scene, rng, arena, &path)) continue;
     const float density = filter_densities ? 0.01f + 3.99f * rng.next_float() : 1.f;
     const auto weights = production_weights(scene, c.algorithm, c.heuristic, light_paths, radius,
-                                            path, arena, density);
+                                            path, arena, density, c.connections, c.pixel_merges);
     const auto oracle =
         oracle_weights(scene, path, connect, merge, c.heuristic == MisHeuristic::Power, light_paths,
-                       radius, arena, density);
+                       radius, arena, density, c.connections);
     if (oracle.empty() || !std::isfinite(oracle.begin()->second))
       continue;  // no technique can make it
     double sum = 0;
@@ -327,12 +332,20 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"cornell", BidirAlgorithm::Vcm, MisHeuristic::Balance, 300},
                       Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Balance, 700},
                       Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Power, 5000},
-                      Case{"corners", BidirAlgorithm::Bpt, MisHeuristic::Balance, 700}),
+                      Case{"corners", BidirAlgorithm::Bpt, MisHeuristic::Balance, 700},
+                      // adaptive-vcm's counts: several connections per camera vertex, fewer
+                      // or more light paths than pixels, pixels that do not merge.
+                      Case{"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Balance, 256, 4},
+                      Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Balance, 2240, 2, false},
+                      Case{"mixed-lights", BidirAlgorithm::Vcm, MisHeuristic::Power, 512, 8},
+                      Case{"cornell-glass", BidirAlgorithm::Bpt, MisHeuristic::Balance, 2048, 2,
+                           false}),
     [](const auto& info) {
-      std::string n = std::string(info.param.scene) + "_" +
-                      std::to_string(int(info.param.algorithm)) + "_" +
-                      (info.param.heuristic == MisHeuristic::Power ? "power" : "balance") + "_N" +
-                      std::to_string(int(info.param.light_paths));
+      std::string n =
+          std::string(info.param.scene) + "_" + std::to_string(int(info.param.algorithm)) + "_" +
+          (info.param.heuristic == MisHeuristic::Power ? "power" : "balance") + "_N" +
+          std::to_string(int(info.param.light_paths)) + "_c" +
+          std::to_string(info.param.connections) + (info.param.pixel_merges ? "" : "_nomerge");
       for (char& ch : n)
         if (ch == '-') ch = '_';
       return n;
@@ -359,7 +372,7 @@ TEST(BidirLightVertex, PackingRoundTrips) {
     v.depth = int(gen() % 200);
     v.throughput = Rgb(u(gen), u(gen), u(gen)) * std::ldexp(1.f, int(gen() % 60) - 30);
     v.mis = {std::ldexp(u(gen), int(gen() % 80) - 40), std::ldexp(u(gen), int(gen() % 80) - 40),
-             u(gen)};
+             u(gen), std::ldexp(u(gen), int(gen() % 80) - 40), v.depth == 1};
     const LightVertexData r = unpack_light_vertex(pack_light_vertex(v));
     EXPECT_EQ(r.p, v.p);                    // exact: merging must not depend on the scene's extent
     EXPECT_LT(length(r.wo - v.wo), 2e-4f);  // angle in radians, to first order
@@ -368,8 +381,11 @@ TEST(BidirLightVertex, PackingRoundTrips) {
     const float m = v.throughput.max_component();
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(r.throughput[c], v.throughput[c], m * 0x1p-16f);  // half a step of 16 bits
-    EXPECT_EQ(r.mis.vcm, v.mis.vcm);
-    EXPECT_EQ(r.mis.vc, v.mis.vc);
-    EXPECT_EQ(r.mis.vm, v.mis.vm);
+    // 24-bit floats: 16 significant bits, rounded.
+    EXPECT_NEAR(r.mis.vcm, v.mis.vcm, v.mis.vcm * 0x1p-16f);
+    EXPECT_NEAR(r.mis.rest, v.mis.rest, v.mis.rest * 0x1p-16f);
+    EXPECT_NEAR(r.mis.conn, v.mis.conn, v.mis.conn * 0x1p-16f);
+    EXPECT_NEAR(r.mis.merge, v.mis.merge, v.mis.merge * 0x1p-16f);
+    EXPECT_EQ(r.mis.first, v.depth == 1);
   }
 }

@@ -241,7 +241,7 @@ TEST(PbrtTextures, ImageMapRelativeToTheSceneFileAndLinearForNonPng) {
   EXPECT_NO_THROW(load_pbrt(main, test::capture_warning));
 }
 
-TEST(PbrtInstancing, ObjectInstancesAreFlattenedCopies) {
+TEST(PbrtInstancing, ObjectInstancesPlaceTheObjectsShapes) {
   auto scene = load_text(
       with_camera("ObjectBegin \"tri\"\nTranslate 0 0 1\n"
                   "Shape \"trianglemesh\" \"point3 P\" [-1 -1 0  1 -1 0  0 1 0]\nObjectEnd\n"

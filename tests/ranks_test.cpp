@@ -61,6 +61,22 @@ TEST(FilmSum, IterationsSplitOverTwoFilmsSumBitIdenticallyToOneFilm) {
   EXPECT_EQ(total.image()[0], one.image()[0]);
 }
 
+TEST(FilmSum, EstimatesOfOneIterationAddExactlyInAnyOrder) {
+  // A splat and a camera sample 2^40 apart: their double sum would round; the film's does not.
+  Image splats(1, 1);
+  splats[0] = Rgb(1.f, -1.f, 0.f);
+  const Rgb sample(0x1p-40f, 0x1p-40f, 0x1p-40f);
+  Film a(1, 1), b(1, 1);
+  a.add_image(splats);
+  a.add_sample(0, 0, sample);
+  a.end_iteration();
+  b.add_sample(0, 0, sample);
+  b.add_image(splats);
+  b.end_iteration();
+  for (int c = 0; c < 3; ++c) EXPECT_TRUE(a.sums()[c] == b.sums()[c]) << c;
+  EXPECT_TRUE(a.sums()[0] == to_fixed(1.0) + to_fixed(0x1p-40)) << "exact, no rounding";
+}
+
 TEST(FilmSum, RejectsAFilmOfAnotherSize) {
   Film a(2, 2), b(2, 3);
   EXPECT_THROW(a.add(b), std::invalid_argument);

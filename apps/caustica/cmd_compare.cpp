@@ -228,12 +228,12 @@ int run_compare(const CompareOptions& o, const CheckedOptions& checks, Ranks& ra
     FileSection writing;
     write_comparison_report(result, reference, dir);
   }
-  std::printf("%-8s %10s %8s %12s %12s %8s %10s\n", "", "iterations", "Mrays/s", "relMSE",
+  std::printf("%-12s %10s %8s %12s %12s %8s %10s\n", "", "iterations", "Mrays/s", "relMSE",
               "relMSE-trim", "SSIM", "vs pt");
   for (const auto& row : comparison_summary(result)) {
     const auto& e = row["errors"];
     const bool has = row.contains("speedup_vs_pt") && row["speedup_vs_pt"].is_number();
-    std::printf("%-8s %10u %8.2f %12.4g %12.4g %8.4f %9.2fx\n",
+    std::printf("%-12s %10u %8.2f %12.4g %12.4g %8.4f %9.2fx\n",
                 row["integrator"].get<std::string>().c_str(), row["iterations"].get<uint32_t>(),
                 row["rays_per_second"].get<double>() * 1e-6, e["relmse"].get<double>(),
                 e["relmse_trimmed"].get<double>(), e["ssim"].get<double>(),

@@ -62,6 +62,11 @@ CLI::Option* add_shared_options(CheckedOptions& o, SharedOptions* s, const std::
            "Photon mapping / VCM: radius reduction alpha in (0, 1] (default 0.75)");
   o.text("--techniques", &s->bidir.techniques_dir,
          "Bidirectional: write one weighted image per technique to DIR");
+  o.integer("--connections", &s->bidir.connections, 1, 64,
+            "bpt / vcm: light subpaths each camera vertex connects to, 1..64 (default 1)");
+  o.choice("--adaptive-costs", &s->adaptive_costs, {"model", "measured"},
+           "adaptive-vcm: price techniques with the fixed cost model (default; deterministic) or "
+           "with costs measured on this machine while rendering (not reproducible)");
   add_guiding_options(o, s);
   return time;
 }
@@ -110,6 +115,7 @@ int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene,
   if (!s.mis.empty())
     settings->mis = s.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
   settings->bidir = s.bidir;
+  settings->bidir.measured_costs = s.adaptive_costs == "measured";
   settings->guiding = s.guiding;
   settings->guiding.max_bytes = size_t(s.guiding_max_mb) << 20;
   settings->guiding.filter = s.guiding_filter == "on";

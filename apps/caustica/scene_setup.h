@@ -22,7 +22,8 @@ struct SceneSetup {
   std::string mis;  // "", "balance" or "power"; empty: each integrator's default
   // Integrator options (every rendering subcommand takes them; integrators that do not use one
   // ignore it).
-  BidirSettings bidir;  // --light-paths, --radius, --radius-alpha, --techniques
+  BidirSettings bidir;  // --light-paths, --radius, --radius-alpha, --techniques, --connections
+  std::string adaptive_costs;  // --adaptive-costs: "", "model" or "measured"
   // --guiding-spatial-threshold, --guiding-rho, --guiding-bsdf-fraction; the others below.
   GuidingSettings guiding;
   int guiding_max_mb = 32;                           // --guiding-max-mb
@@ -42,7 +43,8 @@ constexpr double kMaxSeconds = 30 * 24 * 3600;
 
 // Registers --time (with the command's help text; returned so it can be made required),
 // --threads, --max-depth, --seed, --resolution, --mis, --camera and the integrator options
-// --light-paths, --radius, --radius-alpha, --techniques and --guiding-*.
+// --light-paths, --radius, --radius-alpha, --techniques, --connections, --adaptive-costs and
+// --guiding-*.
 CLI::Option* add_shared_options(CheckedOptions& options, SharedOptions* shared,
                                 const std::string& time_help);
 

@@ -2,6 +2,10 @@
 
 #include <tbb/global_control.h>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -27,8 +31,13 @@ double median(std::vector<double> v) {
 
 // Linux resets a process's peak resident set (VmHWM) when "5" is written to clear_refs
 // (proc(5), since 4.0); then VmHWM after a render is that render's peak. Returns false where
-// that is not allowed, and the caller falls back to the process's peak so far.
+// that is not allowed, and the caller falls back to the process's peak so far. Memory freed
+// before (the raw-ray buffers, earlier renders) is first handed back to the system where the
+// C library keeps it (glibc), so that the peak is the render's and not what was freed before.
 bool reset_peak_memory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
   std::ofstream f("/proc/self/clear_refs");
   f << "5";
   f.flush();

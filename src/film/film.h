@@ -2,12 +2,17 @@
 // estimates: integrators apply the pixel filter by filter importance sampling and weighted splats
 // (pixel_filter.h).
 //
-// Two buffers. The current iteration's estimate is summed in double from zero (a camera sample
-// plus splats, a few additions per pixel); end_iteration() adds it exactly, in 64.64 fixed point
-// (fixed_sum.h), to the total, and clears it. The total therefore depends only on the set of
-// iterations rendered, not on the order or grouping in which they are added: films rendered by
-// several processes and summed (add(), or an MPI reduction over sums()) equal, bit for bit, one
-// film that rendered all their iterations. Cost: 72 bytes per pixel instead of 24.
+// One buffer: every estimate is added exactly, in 64.64 fixed point (fixed_sum.h), to the
+// pixel's total as it arrives. Integer addition is associative, so the total depends only on the
+// set of estimates added, not on the order or grouping in which they are added: films rendered
+// by several processes and summed (add(), or an MPI reduction over sums()) equal, bit for bit,
+// one film that rendered all their iterations. Cost: 48 bytes per pixel (an earlier version
+// also kept a double buffer for the current iteration: 72).
+//
+// Against summing an iteration in double first (that earlier version): a float estimate above
+// 2^-41 converts exactly, so the fixed-point sum of a pixel's estimates is their exact sum, where
+// the double sum could round; the image can therefore differ from that version's only where a
+// double sum rounded and the rounding reached the final float (never seen in practice).
 //
 // Determinism: camera samples are written by the single task that owns the pixel in that
 // iteration; light-tracing splats are gathered in per-chunk buffers that the integrator adds
@@ -41,22 +46,21 @@ class Film {
       nonfinite_.fetch_add(1, std::memory_order_relaxed);
       return;
     }
-    double* p = &current_[3 * (size_t(y) * width_ + x)];
-    p[0] += value.r;
-    p[1] += value.g;
-    p[2] += value.b;
+    add_exactly(size_t(y) * width_ + x, value);
   }
   // Adds a whole image (e.g. merged light-tracing splats), scaled, to the current iteration.
+  // Pixels of value 0 are skipped (adding 0 changes no total).
   void add_image(const Image& image, float scale = 1.f);
   // Counts a discarded non-finite value found by an integrator's own buffers.
   void count_nonfinite(uint64_t n = 1) { nonfinite_.fetch_add(n, std::memory_order_relaxed); }
 
-  // Adds the current iteration exactly to the total and starts the next one from zero.
+  // Ends the current iteration: its estimates are already in the totals; this counts it.
   void end_iteration();
   uint32_t iterations() const { return iterations_; }
   uint64_t nonfinite_count() const { return nonfinite_.load(); }
 
-  // Average over completed iterations.
+  // Average over completed iterations. Between iterations only: an iteration's estimates are
+  // in the totals as soon as they are added, before end_iteration() counts it.
   Image image() const;
 
   // Adds another film's completed iterations (same size): the result is bit-identical to a
@@ -73,8 +77,14 @@ class Film {
 
  private:
   int width_, height_;
-  std::vector<double> current_;  // this iteration's estimates, summed from zero
-  std::vector<FixedSum> total_;  // completed iterations, exactly
+  void add_exactly(size_t pixel, Rgb value) {
+    FixedSum* p = &total_[3 * pixel];
+    p[0] += to_fixed(value.r);
+    p[1] += to_fixed(value.g);
+    p[2] += to_fixed(value.b);
+  }
+
+  std::vector<FixedSum> total_;  // every estimate added so far, exactly
   uint32_t iterations_ = 0;
   std::atomic<uint64_t> nonfinite_{0};
 };

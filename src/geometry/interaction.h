@@ -21,7 +21,11 @@ struct SurfaceInteraction {
   Vec2 uv;        // surface parameterisation (mesh uv, or sphere phi/theta)
   Vec3 wo;        // unit direction back toward the ray origin
   float t = 0;    // ray parameter of the hit
-  uint32_t geom_id = 0, prim_id = 0;   // Embree ids, for debugging and stored light vertices
+  uint32_t geom_id = 0, prim_id = 0;  // Embree ids, for debugging and stored light vertices
+  // The Embree instance (its geometry id in the top-level scene) of a hit on an instanced
+  // object, whose geom_id and prim_id are then those in the object's own Embree scene.
+  uint32_t inst_id = kNoInstance;
+  static constexpr uint32_t kNoInstance = 0xffffffffu;
   const Material* material = nullptr;  // may be null: an interface only (no scattering)
   const Light* area_light = nullptr;   // the emitter of this primitive, if any
 

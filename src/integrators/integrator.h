@@ -25,6 +25,12 @@ struct BidirSettings {
   float radius = 0;            // initial merge radius; 0 = derived from the scene size
   float radius_alpha = 0.75f;  // r_i = r_1 i^((alpha - 1) / 2)
   std::string techniques_dir;  // if set, write one image per technique
+  int connections = 1;         // bpt, vcm: light subpaths each camera vertex connects to
+  // adaptive-vcm: price techniques with costs measured on this machine while rendering
+  // (non-deterministic) instead of the fixed cost model.
+  bool measured_costs = false;
+  // adaptive-vcm: every iteration is a probe (studies of the variance prediction, tests).
+  bool probe_every_iteration = false;
 };
 
 // Settings shared by all integrators, and each family's own struct.

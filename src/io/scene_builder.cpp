@@ -13,13 +13,17 @@ void check_power(const Light& light) {
   if (!light.power().is_finite())
     throw std::runtime_error("an area light's total power overflows to infinity");
 }
-}  // namespace
 
-void SceneBuilder::add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaEmission* emission) {
+void check_mesh(const TriangleMesh& mesh) {
   if (mesh.indices.size() % 3 != 0)
     throw std::runtime_error("triangle mesh index count is not a multiple of 3");
   for (uint32_t i : mesh.indices)
     if (i >= mesh.positions.size()) throw std::runtime_error("triangle mesh index out of range");
+}
+}  // namespace
+
+void SceneBuilder::add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaEmission* emission) {
+  check_mesh(mesh);
   SceneData::MeshEntry entry;
   if (emission && !emission->radiance.is_black()) {
     entry.first_light = uint32_t(data_.lights.size());
@@ -48,6 +52,28 @@ void SceneBuilder::add_sphere(const Sphere& sphere, MaterialPtr material,
 }
 
 void SceneBuilder::add_light(LightPtr light) { data_.lights.push_back(std::move(light)); }
+
+uint32_t SceneBuilder::add_prototype() {
+  data_.prototypes.emplace_back();
+  return uint32_t(data_.prototypes.size() - 1);
+}
+
+void SceneBuilder::add_prototype_mesh(uint32_t prototype, TriangleMesh mesh, MaterialPtr material) {
+  check_mesh(mesh);
+  SceneData::MeshEntry entry;
+  entry.mesh = std::move(mesh);
+  entry.material = std::move(material);
+  data_.prototypes.at(prototype).meshes.push_back(std::move(entry));
+}
+
+void SceneBuilder::add_instance(uint32_t prototype, const Transform& object_to_world) {
+  if (prototype >= data_.prototypes.size())
+    throw std::runtime_error("an instance of a prototype that does not exist");
+  const Mat4& m = object_to_world.matrix();
+  if (m(3, 0) != 0 || m(3, 1) != 0 || m(3, 2) != 0 || m(3, 3) != 1)
+    throw std::runtime_error("an instance transform must be affine");
+  data_.instances.push_back({prototype, object_to_world});
+}
 
 std::unique_ptr<Scene> SceneBuilder::build(const std::string& name) {
   if (!has_camera_) throw std::runtime_error("scene has no camera");

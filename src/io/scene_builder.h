@@ -19,6 +19,13 @@ class SceneBuilder {
   void add_sphere(const Sphere& sphere, MaterialPtr material,
                   const AreaEmission* emission = nullptr);
   void add_light(LightPtr light);
+  // An object placed many times (pbrt-v4 ObjectBegin / ObjectInstance) is stored once: its
+  // meshes, in the object's own space and never emitting, go into a prototype, and each
+  // placement is an instance (an Embree instance, not a copy). add_prototype returns the index
+  // that the other two take; object_to_world must be affine and invertible.
+  uint32_t add_prototype();
+  void add_prototype_mesh(uint32_t prototype, TriangleMesh mesh, MaterialPtr material);
+  void add_instance(uint32_t prototype, const Transform& object_to_world);
   void set_camera(const CameraParams& camera) {
     data_.camera = camera;
     has_camera_ = true;

@@ -17,6 +17,7 @@ namespace caustica {
 class Material;
 class Light;
 class LightSampler;
+struct TriangleVertices;
 
 // Render settings a scene file may carry (pbrt's Sampler/Integrator/Film); the CLI overrides.
 struct SceneSettings {
@@ -38,8 +39,20 @@ struct SceneData {
     std::shared_ptr<const Material> material;
     uint32_t light = UINT32_MAX;  // index of its area light, or none
   };
+  // An object defined once and placed many times (pbrt-v4 ObjectBegin / ObjectInstance): its
+  // meshes in the object's own space, without emitters. The scene builds one Embree scene
+  // for it and places it with one Embree instance per InstanceEntry.
+  struct Prototype {
+    std::vector<MeshEntry> meshes;
+  };
+  struct InstanceEntry {
+    uint32_t prototype = 0;
+    Transform object_to_world;  // affine and invertible
+  };
   std::vector<MeshEntry> meshes;
   std::vector<SphereEntry> spheres;
+  std::vector<Prototype> prototypes;
+  std::vector<InstanceEntry> instances;
   std::vector<std::shared_ptr<class Light>> lights;
   CameraParams camera;
   SceneSettings settings;
@@ -68,8 +81,15 @@ class Scene {
   Bounds3 bounds() const { return bounds_; }
   const SceneSettings& settings() const { return settings_; }
   const std::string& name() const { return name_; }
+  // Triangles as rendered: each instance counts its prototype's triangles again.
   size_t triangle_count() const;
+  // Triangles held in memory: each prototype counted once.
+  size_t stored_triangle_count() const;
   size_t sphere_count() const { return spheres_.size(); }
+  size_t instance_count() const { return instances_.size(); }
+  // Bytes the geometry holds: the meshes' arrays (each prototype's once), the instances, and
+  // Embree's buffers and BVHs as its memory monitor counts them.
+  size_t geometry_bytes() const;
 
   // Rays traced through intersect/occluded since construction (all threads), and how many of
   // them were occlusion rays (the bench weighs the raw Embree bound by this mix).
@@ -85,8 +105,10 @@ class Scene {
 
   // Compact primitive references for stored path vertices (the bidirectional core keeps light
   // vertices small and rebuilds their hit records on demand): a dense index over all triangles
-  // and spheres, and the hit record at point p of that primitive (p is projected onto it) as
-  // intersect() reports it, with wo set to the given direction. Does not count a ray.
+  // and spheres, each instance with its own range (the instance's first index plus the
+  // primitive's index in its prototype), and the hit record at point p of that primitive (p is
+  // projected onto it) as intersect() reports it, with wo set to the given direction. Does not
+  // count a ray.
   uint32_t primitive_index(const SurfaceInteraction& si) const;
   SurfaceInteraction interaction_at(uint32_t primitive_index, Vec3 p, Vec3 wo) const;
   // The dense primitive indices of the shape si lies on (a whole mesh, or one sphere): merging
@@ -98,13 +120,20 @@ class Scene {
   PrimitiveRange shape_primitives(const SurfaceInteraction& si) const;
 
  private:
-  void complete_hit(uint32_t geom_id, uint32_t prim_id, float b1, float b2, Vec3 p_sphere,
-                    SurfaceInteraction* si) const;
+  void build_accelerator();
+  void attach_spheres();
+  void attach_instances();
+  void complete_hit(uint32_t inst_id, uint32_t geom_id, uint32_t prim_id, float b1, float b2,
+                    Vec3 p_sphere, SurfaceInteraction* si) const;
+  const SceneData::MeshEntry& mesh_entry(uint32_t inst_id, uint32_t geom_id) const;
+  TriangleVertices triangle_vertices(uint32_t inst_id, uint32_t geom_id, uint32_t prim_id) const;
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::vector<SceneData::MeshEntry> meshes_;
   std::vector<SceneData::SphereEntry> spheres_;
+  std::vector<SceneData::Prototype> prototypes_;
+  std::vector<SceneData::InstanceEntry> instances_;
   std::vector<std::shared_ptr<Light>> lights_;
   std::vector<const Light*> light_ptrs_, infinite_lights_;
   std::unique_ptr<LightSampler> light_sampler_;

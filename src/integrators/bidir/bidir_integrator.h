@@ -11,6 +11,8 @@
 //        vertex within r (Hachisuka et al. 2008); emission through delta-only chains counted once.
 //   bpm  merging at every camera vertex, MIS over merges (no connections).
 //   vcm  bpt + bpm with MIS over all (merge acceptance p_acc = pi r^2 per light path).
+//   adaptive-vcm  vcm whose light-path count, connections per camera vertex and per-pixel
+//        merging are chosen while rendering by efficiency-aware MIS (adaptive_plan.h).
 //
 // Per iteration: N light subpaths (settings.bidir.light_paths, 0 = one per pixel) are traced in
 // chunks whose size depends on N only (at most 1024 paths; at least 64 chunks when N allows),
@@ -33,7 +35,7 @@
 
 namespace caustica {
 
-enum class BidirAlgorithm { LightTracing, Bpt, Ppm, Bpm, Vcm };
+enum class BidirAlgorithm { LightTracing, Bpt, Ppm, Bpm, Vcm, AdaptiveVcm };
 
 std::unique_ptr<Integrator> make_bidir_integrator(BidirAlgorithm algorithm,
                                                   const IntegratorSettings& settings);

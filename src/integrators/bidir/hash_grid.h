@@ -8,8 +8,9 @@
 // few vertices lie within r, so the scan is the cost. The positions are therefore kept a second
 // time, sorted by bucket, each beside its vertex index in 16 bytes: the scan reads contiguous
 // memory instead of one 40-byte vertex per index, and the vertex is looked up only when it is
-// within r. The order in which fn sees the vertices is unchanged (bucket order, then vertex
-// order within a bucket), so the sums a query makes are too.
+// within r. A query's three dependent cache misses (bucket table, entries, vertex record) are
+// made to overlap across its buckets. The order in which fn sees the vertices is fixed (bucket
+// order, then vertex order within a bucket), so the sums a query makes are too.
 #pragma once
 
 #include <algorithm>
@@ -31,6 +32,50 @@ class HashGrid {
   template <typename Fn>
   void for_each_near(Vec3 p, const std::vector<LightVertex>& vertices, Fn&& fn) const {
     if (cell_start_.empty()) return;
+    uint32_t begin[8], end[8];
+    const int count = buckets_near(p, begin, end);
+    // The vertices within r, in bucket order then vertex order, handed to fn in batches: each
+    // accepted vertex's record is prefetched when it is found (the caller reads it), so those
+    // cache misses overlap instead of following each other, across buckets too.
+    constexpr uint32_t kBatch = 32;
+    uint32_t found[kBatch];
+    uint32_t n = 0;
+    auto flush = [&] {
+      for (uint32_t j = 0; j < n; ++j) {
+        const Entry& e = entries_[found[j]];
+        fn(e.index, Vec3(e.p[0], e.p[1], e.p[2]));
+      }
+      n = 0;
+    };
+    for (int k = 0; k < count; ++k) {
+      for (uint32_t i = begin[k]; i < end[k]; ++i) {
+        const Entry& e = entries_[i];
+        if (distance_squared(p, Vec3(e.p[0], e.p[1], e.p[2])) > radius2_) continue;
+        __builtin_prefetch(&vertices[e.index]);
+        found[n++] = i;
+        if (n == kBatch) flush();
+      }
+    }
+    flush();
+  }
+
+  size_t memory_bytes() const {
+    return (cell_start_.capacity() + cells_.capacity()) * sizeof(uint32_t) +
+           entries_.capacity() * sizeof(Entry);
+  }
+
+ private:
+  // Cell coordinate along axis a relative to the vertices' bounds, in double so that a point far
+  // from the bounds' corner (a huge scene, a tiny radius) still lands in the right cell, and
+  // clamped so that it never overflows the integer conversion (clamped cells only collide).
+  double grid_coordinate(Vec3 p, int a) const {
+    constexpr double kLimit = double(1 << 30);
+    return std::clamp((double(p[a]) - double(lo_[a])) * inv_cell_, -kLimit, kLimit);
+  }
+  // The distinct buckets of the 2x2x2 cells a ball of radius r around p can touch, as entry
+  // ranges [begin, end): their count. The table lookups are independent loads (their cache
+  // misses overlap), and each bucket's first entries are prefetched before any is scanned.
+  int buckets_near(Vec3 p, uint32_t* begin, uint32_t* end) const {
     int c[3], n[3];
     for (int a = 0; a < 3; ++a) {
       const double g = grid_coordinate(p, a);
@@ -45,42 +90,11 @@ class HashGrid {
       if (std::find(buckets, buckets + count, b) == buckets + count) buckets[count++] = b;
     }
     for (int k = 0; k < count; ++k) {
-      const uint32_t cell = buckets[k];
-      // Two passes over each batch: find the vertices within r and prefetch each one's record
-      // (the caller reads it: one cache miss per accepted vertex, which now overlap instead of
-      // following each other), then hand them to fn in the same order.
-      constexpr uint32_t kBatch = 32;
-      uint32_t found[kBatch];
-      for (uint32_t i = cell_start_[cell], end = cell_start_[cell + 1]; i < end;) {
-        uint32_t n = 0;
-        for (; i < end && n < kBatch; ++i) {
-          const Entry& e = entries_[i];
-          const Vec3 q(e.p[0], e.p[1], e.p[2]);
-          if (distance_squared(p, q) <= radius2_) {
-            __builtin_prefetch(&vertices[e.index]);
-            found[n++] = i;
-          }
-        }
-        for (uint32_t j = 0; j < n; ++j) {
-          const Entry& e = entries_[found[j]];
-          fn(e.index, Vec3(e.p[0], e.p[1], e.p[2]));
-        }
-      }
+      begin[k] = cell_start_[buckets[k]];
+      end[k] = cell_start_[buckets[k] + 1];
+      __builtin_prefetch(entries_.data() + begin[k]);
     }
-  }
-
-  size_t memory_bytes() const {
-    return (cell_start_.capacity() + cells_.capacity() + fill_.capacity()) * sizeof(uint32_t) +
-           entries_.capacity() * sizeof(Entry);
-  }
-
- private:
-  // Cell coordinate along axis a relative to the vertices' bounds, in double so that a point far
-  // from the bounds' corner (a huge scene, a tiny radius) still lands in the right cell, and
-  // clamped so that it never overflows the integer conversion (clamped cells only collide).
-  double grid_coordinate(Vec3 p, int a) const {
-    constexpr double kLimit = double(1 << 30);
-    return std::clamp((double(p[a]) - double(lo_[a])) * inv_cell_, -kLimit, kLimit);
+    return count;
   }
   uint32_t cell_of(Vec3 p) const {
     return hash(int(std::floor(grid_coordinate(p, 0))), int(std::floor(grid_coordinate(p, 1))),
@@ -103,7 +117,6 @@ class HashGrid {
   std::vector<Entry> entries_;        // sorted by bucket, in vertex order within one
   // Build scratch, kept so that a build allocates nothing once the sizes have been reached.
   std::vector<uint32_t> cells_;  // per vertex: its bucket
-  std::vector<uint32_t> fill_;   // per bucket: next free slot
 };
 
 }  // namespace caustica::bidir

@@ -9,11 +9,12 @@
 //                one far-away object put photons off their surface and merging went dark.
 //   bytes 12-15  dense primitive index
 //   bytes 16-19  wo: octahedral 2 x 16 bit (~5e-5 rad)
-//   bytes 20-31  dVCM, dVC, dVM as floats, exactly
+//   bytes 20-31  the four MIS sums (mis.h: dVCM and the three class sums) as 24-bit floats: sign,
+//                8-bit exponent and 15 mantissa bits, rounded (relative error <= 2^-16)
 //   bytes 32-39  depth (8) | throughput shared exponent (8) | mantissas 3 x 16 bit (relative error
 //                <= 2^-17 of the largest channel)
 // Why 40 and not 32: exact positions take 96 bits, the primitive and wo 64; the 96 left are not
-// enough for three MIS sums at the precision the partition-of-unity test needs (1e-4) plus the
+// enough for the MIS sums at the precision the partition-of-unity test needs (1e-4) plus the
 // throughput and depth. 40 bytes keeps a vertex within one cache line more often than not (8 of
 // 8 consecutive vertices fit in 5 lines) and is 62% of SmallVCM's 64-byte vertex.
 #pragma once
@@ -29,8 +30,8 @@ namespace caustica::bidir {
 struct LightVertex {
   float position[3];
   uint32_t primitive;
-  uint32_t wo;  // octahedral
-  float vcm, vc, vm;
+  uint32_t wo;      // octahedral
+  uint8_t mis[12];  // four 24-bit floats
   uint64_t depth_and_throughput;
 
   Vec3 p() const { return {position[0], position[1], position[2]}; }

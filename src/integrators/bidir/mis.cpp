@@ -11,22 +11,68 @@ namespace {
 // (a grazing cosine or a zero pdf in a denominator). The limit of the product as the zero factor
 // goes to 0 is 0, so 0 * inf is 0 here, where IEEE says NaN.
 float times(float a, float b) { return a == 0.f || b == 0.f ? 0.f : a * b; }
-// 1 / (1 + others): an infinite sum of other techniques is the limit weight 0. A NaN can now only
-// come from a 0 / 0 inside one pdf ratio, which has no limit to give; it gets weight 0.
-float full_weight(float others) { return others == others ? 1.f / (1.f + others) : 0.f; }
+
+float& term(TechniqueTerms& t, TechniqueClass c) {
+  switch (c) {
+    case TechniqueClass::Emitter:
+      return t.emitter;
+    case TechniqueClass::LightTrace:
+      return t.light_trace;
+    case TechniqueClass::Merge:
+      return t.merge;
+    case TechniqueClass::Connect:
+      break;
+  }
+  return t.connect;
+}
+
+float others(const TechniqueTerms& t, const MisCounts& n) {
+  return times(n.emitter, t.emitter) + times(n.light_trace, t.light_trace) +
+         times(n.connect, t.connect) + times(n.merge, t.merge);
+}
+}  // namespace
+
+float TechniqueTerms::weight(const MisCounts& counts) const {
+  const float own_count = counts.of(own);
+  if (!(own_count > 0)) return 0.f;
+  // 1 / (1 + others): an infinite sum of other techniques is the limit weight 0. A NaN can only
+  // come from a 0 / 0 inside one pdf ratio, which has no limit to give; it gets weight 0.
+  const float x = others(*this, counts) / own_count;
+  return x == x ? 1.f / (1.f + x) : 0.f;
+}
+
+float TechniqueTerms::denominator(const MisCounts& counts) const {
+  return counts.of(own) + others(*this, counts);
+}
+
+MisRules::MisRules(MisHeuristic heuristic, const MisCounts& counts)
+    : power_(heuristic == MisHeuristic::Power) {
+  counts_ = {mis(counts.emitter), mis(counts.light_trace), mis(counts.connect), mis(counts.merge)};
+}
+
+namespace {
+MisCounts classic_counts(bool connect, bool merge, float light_paths, float radius) {
+  MisCounts c;
+  c.emitter = c.connect = connect ? 1.f : 0.f;
+  c.light_trace = connect ? light_paths : 0.f;
+  c.merge = merge ? kPi * radius * radius * light_paths : 0.f;  // tech. rep. eq. 20
+  return c;
+}
 }  // namespace
 
 MisRules::MisRules(MisHeuristic heuristic, bool connect, bool merge, float light_paths,
                    float radius)
-    : power_(heuristic == MisHeuristic::Power), light_paths_(light_paths) {
-  const float eta_vcm = kPi * radius * radius * light_paths;  // tech. rep. eq. 20
-  vm_factor_ = merge ? mis(eta_vcm) : 0.f;
-  vc_factor_ = connect && eta_vcm > 0 ? mis(1.f / eta_vcm) : 0.f;
+    : MisRules(heuristic, classic_counts(connect, merge, light_paths, radius)) {}
+
+MisRules MisRules::with_merging(bool merge) const {
+  MisRules r = *this;
+  if (!merge) r.counts_.merge = 0;
+  return r;
 }
 
 MisSums MisRules::camera_start(float camera_pdf_w) const {
-  // dVCM = n_LT / p(camera ray): the light-tracing technique uses N samples per pixel.
-  return {mis(light_paths_ / camera_pdf_w), 0.f, 0.f};
+  // dVCM = 1 / p(camera ray): the light-tracing technique (its count enters at the weights).
+  return {mis(1.f / camera_pdf_w), 0.f, 0.f, 0.f, true};
 }
 
 MisSums MisRules::light_first_hit(float direct_pdf, float emission_pdf, float cos_at_light,
@@ -35,11 +81,10 @@ MisSums MisRules::light_first_hit(float direct_pdf, float emission_pdf, float co
   MisSums s;
   // eq. 31: the ratio of the direct-sampling pdf of y0 to the emission pdf of (y0, y1).
   s.vcm = mis(direct_pdf / emission_pdf);
-  // eqs. 32-33; delta lights cannot be hit, so nothing connects "behind" them (eqs. 48-50).
+  // eqs. 32-33: the camera subpath hitting y0; delta lights cannot be hit (eqs. 48-50).
   // Infinite lights measure y0 in solid angle: cos at the light is 1 and no distance enters
   // (tech. rep. section 5.1).
-  s.vc = delta_light ? 0.f : mis((finite_light ? cos_at_light : 1.f) / emission_pdf);
-  s.vm = times(s.vc, vc_factor_);
+  s.rest = delta_light ? 0.f : mis((finite_light ? cos_at_light : 1.f) / emission_pdf);
   if (finite_light) s.vcm = times(s.vcm, mis(dist2));
   hit(s, 1.f, cos_at_hit);
   return s;
@@ -49,70 +94,99 @@ void MisRules::hit(MisSums& s, float dist2, float cos_at_hit) const {
   // Completes eqs. 34-36: the forward pdf of this vertex gains |cos| / dist^2.
   const float inv_cos = 1.f / mis(cos_at_hit);
   s.vcm = times(times(s.vcm, mis(dist2)), inv_cos);
-  s.vc = times(s.vc, inv_cos);
-  s.vm = times(s.vm, inv_cos);
+  s.rest = times(s.rest, inv_cos);
+  s.conn = times(s.conn, inv_cos);
+  s.merge = times(s.merge, inv_cos);
 }
 
 void MisRules::scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev,
                        bool specular) const {
+  const bool first = s.first;
+  s.first = false;
   if (specular) {
     // eqs. 53-55: no technique can end at a specular vertex (dVCM = 0); pdf_rev == pdf_fwd
     // cancels and only the cosine of the reverse area conversion remains.
     s.vcm = 0.f;
-    s.vc = times(s.vc, mis(cos_out));
-    s.vm = times(s.vm, mis(cos_out));
+    const float c = mis(cos_out);
+    s.rest = times(s.rest, c);
+    s.conn = times(s.conn, c);
+    s.merge = times(s.merge, c);
     return;
   }
-  // eqs. 34-36 (the 1/dist^2 and 1/cos of the next vertex follow in hit()).
+  // eqs. 34-36 (the 1/dist^2 and 1/cos of the next vertex follow in hit()). The vertex's own
+  // ratio dVCM joins the class of the technique it stands for: at a subpath's first vertex NEE
+  // (light subpath) or light tracing (camera subpath), further on a connection. Merging at this
+  // vertex adds 1 (its count enters at the weights).
   const float g = mis(cos_out / pdf_fwd);
   const float rev = mis(pdf_rev);
-  const float vc = times(g, times(s.vc, rev) + s.vcm + vm_factor_);
-  const float vm = times(g, times(s.vm, rev) + times(s.vcm, vc_factor_) + 1.f);
+  s.rest = times(g, times(s.rest, rev) + (first ? s.vcm : 0.f));
+  s.conn = times(g, times(s.conn, rev) + (first ? 0.f : s.vcm));
+  s.merge = times(g, times(s.merge, rev) + 1.f);
   s.vcm = mis(1.f / pdf_fwd);
-  s.vc = vc;
-  s.vm = vm;
 }
 
-float MisRules::hit_light(const MisSums& camera, float direct_pdf, float emission_pdf) const {
-  // eqs. 42-43: the light subpath is empty; the camera side sums NEE and all connections.
-  const float w_camera = times(mis(direct_pdf), camera.vcm) + times(mis(emission_pdf), camera.vc);
-  return full_weight(w_camera);
+void MisRules::add_beyond(TechniqueTerms& t, const MisSums& s, TechniqueClass rest_class,
+                          float scale, float pdf_rev, bool with_merge_here) const {
+  if (with_merge_here) t.merge += scale;
+  term(t, s.first ? rest_class : TechniqueClass::Connect) += times(scale, s.vcm);
+  const float r = times(scale, mis(pdf_rev));
+  term(t, rest_class) += times(r, s.rest);
+  t.connect += times(r, s.conn);
+  t.merge += times(r, s.merge);
 }
 
-float MisRules::next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf_pdf_rev,
-                           float direct_pdf_w, float emission_pdf_w, float cos_to_light,
-                           float cos_at_light) const {
+TechniqueTerms MisRules::hit_light(const MisSums& camera, float direct_pdf,
+                                   float emission_pdf) const {
+  // eqs. 42-43: the light subpath is empty; the camera side holds NEE and everything further.
+  TechniqueTerms t;
+  t.own = TechniqueClass::Emitter;
+  t.emitter = times(mis(direct_pdf), camera.vcm);
+  const float e = mis(emission_pdf);
+  t.light_trace = times(e, camera.rest);
+  t.connect = times(e, camera.conn);
+  t.merge = times(e, camera.merge);
+  return t;
+}
+
+TechniqueTerms MisRules::next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf_pdf_rev,
+                                    float direct_pdf_w, float emission_pdf_w, float cos_to_light,
+                                    float cos_at_light) const {
+  TechniqueTerms t;
+  t.own = TechniqueClass::Emitter;
   // eq. 44: BSDF sampling hitting the light instead (both solid angle at the camera vertex).
-  const float w_light = mis(bsdf_pdf_fwd / direct_pdf_w);
+  t.emitter = mis(bsdf_pdf_fwd / direct_pdf_w);
   // eq. 45: emission_pdf_a / direct_pdf_a at the camera vertex; the dist^2 of both cancel.
-  const float w_camera = times(mis(emission_pdf_w * cos_to_light / (direct_pdf_w * cos_at_light)),
-                               vm_factor_ + camera.vcm + times(camera.vc, mis(bsdf_pdf_rev)));
-  return full_weight(w_light + w_camera);
+  add_beyond(t, camera, TechniqueClass::LightTrace,
+             mis(emission_pdf_w * cos_to_light / (direct_pdf_w * cos_at_light)), bsdf_pdf_rev,
+             true);
+  return t;
 }
 
-float MisRules::connect(const MisSums& light, const MisSums& camera, float camera_pdf_a,
-                        float camera_rev_w, float light_pdf_a, float light_rev_w) const {
-  const float w_light = times(
-      mis(camera_pdf_a), vm_factor_ + light.vcm + times(light.vc, mis(light_rev_w)));  // eq. 40
-  const float w_camera = times(
-      mis(light_pdf_a), vm_factor_ + camera.vcm + times(camera.vc, mis(camera_rev_w)));  // eq. 41
-  return full_weight(w_light + w_camera);
+TechniqueTerms MisRules::connect(const MisSums& light, const MisSums& camera, float camera_pdf_a,
+                                 float camera_rev_w, float light_pdf_a, float light_rev_w) const {
+  TechniqueTerms t;
+  t.own = TechniqueClass::Connect;
+  add_beyond(t, light, TechniqueClass::Emitter, mis(camera_pdf_a), light_rev_w, true);  // eq. 40
+  add_beyond(t, camera, TechniqueClass::LightTrace, mis(light_pdf_a), camera_rev_w,
+             true);  // eq. 41
+  return t;
 }
 
-float MisRules::light_to_camera(const MisSums& light, float camera_pdf_a, float light_rev_w) const {
-  // eq. 46, with the camera density divided by the N light paths that share each pixel.
-  const float w_light = times(mis(camera_pdf_a / light_paths_),
-                              vm_factor_ + light.vcm + times(light.vc, mis(light_rev_w)));
-  return full_weight(w_light);
+TechniqueTerms MisRules::light_to_camera(const MisSums& light, float camera_pdf_a,
+                                         float light_rev_w) const {
+  TechniqueTerms t;
+  t.own = TechniqueClass::LightTrace;
+  add_beyond(t, light, TechniqueClass::Emitter, mis(camera_pdf_a), light_rev_w, true);  // eq. 46
+  return t;
 }
 
-float MisRules::merge(const MisSums& light, const MisSums& camera, float camera_pdf_fwd_w,
-                      float camera_pdf_rev_w) const {
-  const float w_light =
-      times(light.vcm, vc_factor_) + times(light.vm, mis(camera_pdf_fwd_w));  // eq. 38
-  const float w_camera =
-      times(camera.vcm, vc_factor_) + times(camera.vm, mis(camera_pdf_rev_w));  // eq. 39
-  return full_weight(w_light + w_camera);
+TechniqueTerms MisRules::merge(const MisSums& light, const MisSums& camera, float camera_pdf_fwd_w,
+                               float camera_pdf_rev_w) const {
+  TechniqueTerms t;
+  t.own = TechniqueClass::Merge;
+  add_beyond(t, light, TechniqueClass::Emitter, 1.f, camera_pdf_fwd_w, false);      // eq. 38
+  add_beyond(t, camera, TechniqueClass::LightTrace, 1.f, camera_pdf_rev_w, false);  // eq. 39
+  return t;
 }
 
 }  // namespace caustica::bidir

@@ -1,36 +1,92 @@
-// MIS weights of the bidirectional family through the incremental partial sums dVCM, dVC, dVM
-// of Georgiev's tech report "Implementing Vertex Connection and Merging" (2012). Each subpath
-// vertex carries three numbers from which the weight of any technique that ends the subpath
-// there follows in O(1); the updates below are the report's equations, written once and used
-// by the renderer and by the tests' replay of explicit paths alike.
+// MIS weights of the bidirectional family through incremental partial sums, after Georgiev's
+// tech report "Implementing Vertex Connection and Merging" (2012), generalised to a sample count
+// per technique class, as efficiency-aware MIS needs (Grittmann et al. 2022):
+//
+//   emitter      the camera subpath hits an emitter (s = 0) or connects to a light sample
+//                (s = 1, NEE): one sample each per camera vertex, or none (bpm);
+//   light_trace  a light vertex connected to the lens (t = 1): N light paths per pixel;
+//   connect      a light vertex connected to a camera vertex (s, t >= 2): c per camera vertex;
+//   merge        vertex merging: N pi r^2 per camera vertex (acceptance area x light paths),
+//                or 0 in a pixel that does not merge.
+//
+// The balance heuristic weights technique k of a path by n_k p_k / sum_j n_j p_j. Each subpath
+// vertex carries the sums of p_j / p_current over the techniques "behind" it, split by class
+// and free of counts (MisSums); a weight combines them with the counts of the iteration and
+// pixel (MisCounts) in O(1). Because the split terms of a weight are exposed (TechniqueTerms),
+// the same path also gives the weight it *would* have had under other counts: the proxy
+// correction factors with which adaptive-vcm estimates the variance of other configurations.
 //
 // Conventions: every pdf handed in is in solid angle unless its name ends in _a (area measure
 // at the point it samples); area conversions use the *geometric* normal (|ng . w|), both here
 // and in the tests' brute-force oracle. Delta (specular) bounces report pdf_fwd = pdf_rev and
 // only their cosine survives. Russian roulette is left out of the pdfs (the weights still sum to
 // one over the techniques; they are just not the exact balance weights of the RR'd estimator).
+// The power heuristic squares every ratio and count (mis()).
 #pragma once
 
 #include "integrators/integrator.h"
 
 namespace caustica::bidir {
 
-// The three partial sums a subpath carries to its last vertex (tech. rep. section 4).
+// Technique classes (see above).
+enum class TechniqueClass : uint8_t { Emitter, LightTrace, Connect, Merge };
+
+// Samples per pixel and camera vertex of each class; 0 switches a class off.
+struct MisCounts {
+  float emitter = 1;
+  float light_trace = 0;  // N: the light paths of an iteration each reach every pixel
+  float connect = 1;
+  float merge = 0;  // N pi r^2
+  float of(TechniqueClass c) const {
+    switch (c) {
+      case TechniqueClass::Emitter:
+        return emitter;
+      case TechniqueClass::LightTrace:
+        return light_trace;
+      case TechniqueClass::Connect:
+        return connect;
+      case TechniqueClass::Merge:
+        return merge;
+    }
+    return 0;
+  }
+};
+
+// The partial sums a subpath carries to its last vertex, without counts.
 struct MisSums {
-  float vcm = 0;  // dVCM: terms shared by connection and merging (the vertex's own pdf ratio)
-  float vc = 0;   // dVC: techniques that connect further along the subpath
-  float vm = 0;   // dVM: techniques that merge further along the subpath
+  float vcm = 0;      // dVCM: the vertex's own reverse-sampling ratio (tech. rep. section 4)
+  float rest = 0;     // techniques behind of the subpath's first class: Emitter on the light
+                      // subpath (s' <= 1), LightTrace on the camera subpath (t' = 1)
+  float conn = 0;     // connections behind (s', t' >= 2)
+  float merge = 0;    // merges behind
+  bool first = true;  // the vertex is its subpath's first: vcm belongs to the "rest" class
+};
+
+// The other techniques of one path relative to the current one, sum_k p_k / p_current by class
+// (already through mis()), and the current technique's class.
+struct TechniqueTerms {
+  TechniqueClass own = TechniqueClass::Connect;
+  float emitter = 0, light_trace = 0, connect = 0, merge = 0;
+  // The weight under `counts` (mis()'d counts, MisRules::counts()).
+  float weight(const MisCounts& counts) const;
+  // sum_k n_k p_k / p_current including the current technique: 1 / weight * own count.
+  float denominator(const MisCounts& counts) const;
 };
 
 // Per-iteration constants of the weights and the update rules.
 class MisRules {
  public:
-  // light_paths = N; radius = the iteration's merge radius. Technique switches decide which
-  // families take part: eta_VCM = N pi r^2 (tech. rep. eq. 20 with n_VC = 1, n_VM = N).
+  MisRules(MisHeuristic heuristic, const MisCounts& counts);
+  // The classic switches: connect = emitter hits, NEE, connections and light tracing (N per
+  // pixel); merge = N pi r^2 (tech. rep. eq. 20).
   MisRules(MisHeuristic heuristic, bool connect, bool merge, float light_paths, float radius);
 
   float mis(float x) const { return power_ ? x * x : x; }
-  float light_paths() const { return light_paths_; }
+  bool power() const { return power_; }
+  // The counts through mis(), as the weights use them.
+  const MisCounts& counts() const { return counts_; }
+  // The same rules in a pixel that merges or not (merge count 0).
+  MisRules with_merging(bool merge) const;
 
   // Camera subpath start; camera_pdf_w is the per-pixel solid-angle density of the primary ray
   // (pixel_count * pdf_we * the pixel filter's raster density, techniques.h). tech. rep. eqs.
@@ -47,35 +103,39 @@ class MisRules {
   // Scattering from a vertex: cos_out = |ng . wi| there, pdf_fwd / pdf_rev of the bounce.
   void scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev, bool specular) const;
 
-  // Full weights 1 / (w_light + 1 + w_camera), eq. 37, for each way a path is completed.
+  // The terms of each way a path is completed (eq. 37 with counts); weight = terms.weight().
   // Camera subpath hits an emitter (s = 0): direct_pdf in the measure of light_first_hit
   // (area, or solid angle for infinite lights), emission_pdf = pmf * pdf_pos * pdf_dir.
-  float hit_light(const MisSums& camera, float direct_pdf, float emission_pdf) const;
+  TechniqueTerms hit_light(const MisSums& camera, float direct_pdf, float emission_pdf) const;
   // Next event estimation (s = 1). bsdf_pdf_fwd is 0 for delta lights; direct_pdf_w includes the
   // pmf and is pmf * dist^2 for delta positions (area density 1); cos_to_light = |ng . wi| at the
   // camera vertex; cos_at_light = 1 for point-like and infinite lights. eqs. 44-45.
-  float next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf_pdf_rev,
-                   float direct_pdf_w, float emission_pdf_w, float cos_to_light,
-                   float cos_at_light) const;
+  TechniqueTerms next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf_pdf_rev,
+                            float direct_pdf_w, float emission_pdf_w, float cos_to_light,
+                            float cos_at_light) const;
   // Connection of a light vertex and a camera vertex (s, t >= 2). camera_pdf_a: the camera
   // vertex's BSDF sampling the light vertex (area at the light vertex); light_pdf_a the converse;
   // the _rev_w pdfs: each vertex's BSDF sampling its own predecessor given the connection. eqs.
   // 40-41.
-  float connect(const MisSums& light, const MisSums& camera, float camera_pdf_a, float camera_rev_w,
-                float light_pdf_a, float light_rev_w) const;
+  TechniqueTerms connect(const MisSums& light, const MisSums& camera, float camera_pdf_a,
+                         float camera_rev_w, float light_pdf_a, float light_rev_w) const;
   // Light vertex connected to the camera (t = 1): camera_pdf_a = per-pixel camera density of the
   // light vertex in area measure; light_rev_w its BSDF sampling its predecessor. eqs. 46-47.
-  float light_to_camera(const MisSums& light, float camera_pdf_a, float light_rev_w) const;
+  TechniqueTerms light_to_camera(const MisSums& light, float camera_pdf_a, float light_rev_w) const;
   // Merge of a light vertex with a camera vertex: the camera BSDF's pdfs of the light's incoming
   // direction (fwd) and of its own outgoing direction given that one (rev). eqs. 38-39.
-  float merge(const MisSums& light, const MisSums& camera, float camera_pdf_fwd_w,
-              float camera_pdf_rev_w) const;
+  TechniqueTerms merge(const MisSums& light, const MisSums& camera, float camera_pdf_fwd_w,
+                       float camera_pdf_rev_w) const;
 
  private:
+  // Adds to t, scaled by `scale`, the techniques that sample this vertex from the other side
+  // (`with_merge_here`: merging at the vertex) and those further along the subpath (the sums
+  // times mis(pdf_rev)). rest_class: Emitter on the light subpath, LightTrace on the camera's.
+  void add_beyond(TechniqueTerms& t, const MisSums& s, TechniqueClass rest_class, float scale,
+                  float pdf_rev, bool with_merge_here) const;
+
   bool power_;
-  float light_paths_;
-  float vm_factor_;  // Mis(eta_VCM) if merging takes part, else 0
-  float vc_factor_;  // Mis(1 / eta_VCM) if connections take part, else 0
+  MisCounts counts_;  // through mis()
 };
 
 }  // namespace caustica::bidir

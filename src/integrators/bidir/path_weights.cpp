@@ -12,10 +12,16 @@ namespace caustica::bidir {
 std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
                                                 MisHeuristic heuristic, float light_paths,
                                                 float radius, const ExplicitPath& path,
-                                                ScratchArena& arena, float raster_density) {
+                                                ScratchArena& arena, float raster_density,
+                                                int connections, bool pixel_merges) {
   const bool connect = algorithm != BidirAlgorithm::Bpm;
-  const bool merge = algorithm != BidirAlgorithm::Bpt;
-  const MisRules rules(heuristic, connect, merge, light_paths, radius);
+  const bool merge = algorithm != BidirAlgorithm::Bpt && pixel_merges;
+  MisCounts counts;
+  counts.emitter = connect ? 1.f : 0.f;
+  counts.light_trace = connect ? light_paths : 0.f;
+  counts.connect = connect ? float(connections) : 0.f;
+  counts.merge = merge ? kPi * radius * radius * light_paths : 0.f;
+  const MisRules rules(heuristic, counts);
   const Light& light = *path.light;
   const float pmf = scene.light_sampler().pmf(&light);
   const bool finite = !light.is_infinite();
@@ -103,9 +109,9 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
       emitter.ng = path.light_normal;
       emitter.wo = dir(0, 1);
       rules.hit(m, distance_squared(x[0], x[1]), geometric_cos(emitter, emitter.wo));
-      w = weight_emitter_hit(rules, light, pmf, x[1], to_light, &emitter, m);
+      w = terms_emitter_hit(rules, light, pmf, x[1], to_light, &emitter, m).weight(rules.counts());
     } else {
-      w = weight_emitter_hit(rules, light, pmf, x[1], to_light, nullptr, m);
+      w = terms_emitter_hit(rules, light, pmf, x[1], to_light, nullptr, m).weight(rules.counts());
     }
     out.push_back({false, 0, k + 1, w});
   }
@@ -120,28 +126,31 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
     light.pdf_le(x[0], le.n, -ls.wi, &ls.pdf_emit_pos, &ls.pdf_emit_dir);
     ls.cos_at_light = light.type() == LightType::Area ? abs_dot(path.light_normal, ls.wi) : 1.f;
     out.push_back({false, 1, k,
-                   weight_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1])});
+                   terms_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1])
+                       .weight(rules.counts())});
   }
   // 2 <= s <= k - 1: connections of x(s-1) and x(s).
   for (int s = 2; connect && s <= k - 1; ++s) {
     if (delta(s - 1) || delta(s)) continue;
     out.push_back({false, s, k + 1 - s,
-                   weight_connection(rules, light_si[s - 1], bsdf[s - 1], light_si[s - 1].wo,
-                                     stored(s - 1), camera_si[s], bsdf[s], camera_mis[s])});
+                   terms_connection(rules, light_si[s - 1], bsdf[s - 1], light_si[s - 1].wo,
+                                    stored(s - 1), camera_si[s], bsdf[s], camera_mis[s])
+                       .weight(rules.counts())});
   }
   // t = 1: x(k-1) connected to the lens.
   if (connect && k >= 2 && !delta(k - 1)) {
-    out.push_back(
-        {false, k, 1,
-         weight_light_to_camera(rules, scene.camera(), light_si[k - 1], bsdf[k - 1],
-                                light_si[k - 1].wo, stored(k - 1), x[k], raster_density)});
+    out.push_back({false, k, 1,
+                   terms_light_to_camera(rules, scene.camera(), light_si[k - 1], bsdf[k - 1],
+                                         light_si[k - 1].wo, stored(k - 1), x[k], raster_density)
+                       .weight(rules.counts())});
   }
   // Merges at every non-delta interior vertex.
   for (int j = 1; merge && j <= k - 1; ++j) {
     if (delta(j)) continue;
     out.push_back(
         {true, j + 1, k + 1 - j,
-         weight_merge(rules, light_si[j].wo, stored(j), camera_si[j], bsdf[j], camera_mis[j])});
+         terms_merge(rules, light_si[j].wo, stored(j), camera_si[j], bsdf[j], camera_mis[j])
+             .weight(rules.counts())});
   }
   return out;
 }

@@ -37,9 +37,12 @@ struct TechniqueWeight {
 // (delta vertices are recognised by Bsdf::is_delta; mixed BSDFs are treated as non-delta).
 // raster_density: the pixel filter's density of the path's raster offset from the centre of the
 // pixel it is estimated for (camera_pdf_w; 1 for the box of radius 1/2).
+// connections: light subpaths each camera vertex connects to (their count in the weights);
+// pixel_merges: false for a pixel of adaptive-vcm that does not merge.
 std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
                                                 MisHeuristic heuristic, float light_paths,
                                                 float radius, const ExplicitPath& path,
-                                                ScratchArena& arena, float raster_density = 1.f);
+                                                ScratchArena& arena, float raster_density = 1.f,
+                                                int connections = 1, bool pixel_merges = true);
 
 }  // namespace caustica::bidir

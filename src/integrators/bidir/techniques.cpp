@@ -38,8 +38,8 @@ void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteractio
   rules.scatter(mis, geometric_cos(si, wi), pdf_fwd, pdf_rev, specular);
 }
 
-float weight_emitter_hit(const MisRules& rules, const Light& light, float pmf, Vec3 prev_p,
-                         Vec3 dir, const SurfaceInteraction* hit, const MisSums& camera) {
+TechniqueTerms terms_emitter_hit(const MisRules& rules, const Light& light, float pmf, Vec3 prev_p,
+                                 Vec3 dir, const SurfaceInteraction* hit, const MisSums& camera) {
   float pdf_pos = 0, pdf_dir = 0, direct;
   if (hit) {
     light.pdf_le(hit->p, hit->ng, hit->wo, &pdf_pos, &pdf_dir);
@@ -52,9 +52,9 @@ float weight_emitter_hit(const MisRules& rules, const Light& light, float pmf, V
   return rules.hit_light(camera, direct, pmf * pdf_pos * pdf_dir);
 }
 
-float weight_next_event(const MisRules& rules, const Light& light, float pmf,
-                        const LightLiSample& ls, const SurfaceInteraction& si, const Bsdf& bsdf,
-                        const MisSums& camera) {
+TechniqueTerms terms_next_event(const MisRules& rules, const Light& light, float pmf,
+                                const LightLiSample& ls, const SurfaceInteraction& si,
+                                const Bsdf& bsdf, const MisSums& camera) {
   const float bsdf_fwd = light.is_delta() ? 0.f : bsdf.pdf(si.wo, ls.wi, TransportMode::Radiance);
   const float bsdf_rev = bsdf.pdf(ls.wi, si.wo, TransportMode::Importance);
   // Delta positions have area density 1: in solid angle at si that is dist^2.
@@ -65,10 +65,10 @@ float weight_next_event(const MisRules& rules, const Light& light, float pmf,
                           geometric_cos(si, ls.wi), ls.cos_at_light);
 }
 
-float weight_connection(const MisRules& rules, const SurfaceInteraction& light_si,
-                        const Bsdf& light_bsdf, Vec3 light_wo, const MisSums& light,
-                        const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
-                        const MisSums& camera) {
+TechniqueTerms terms_connection(const MisRules& rules, const SurfaceInteraction& light_si,
+                                const Bsdf& light_bsdf, Vec3 light_wo, const MisSums& light,
+                                const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
+                                const MisSums& camera) {
   const Vec3 d = light_si.p - camera_si.p;
   const float dist2 = length_squared(d);
   const Vec3 dir = d / std::sqrt(dist2);  // camera vertex -> light vertex
@@ -81,9 +81,9 @@ float weight_connection(const MisRules& rules, const SurfaceInteraction& light_s
   return rules.connect(light, camera, camera_pdf_a, camera_rev, light_pdf_a, light_rev);
 }
 
-float weight_light_to_camera(const MisRules& rules, const Camera& camera,
-                             const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
-                             const MisSums& light, Vec3 p_lens, float raster_density) {
+TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera,
+                                     const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
+                                     const MisSums& light, Vec3 p_lens, float raster_density) {
   const Vec3 d = p_lens - si.p;
   const float dist2 = length_squared(d);
   const Vec3 dir = d / std::sqrt(dist2);
@@ -93,9 +93,9 @@ float weight_light_to_camera(const MisRules& rules, const Camera& camera,
   return rules.light_to_camera(light, camera_pdf_a, rev);
 }
 
-float weight_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,
-                   const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
-                   const MisSums& camera) {
+TechniqueTerms terms_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,
+                           const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
+                           const MisSums& camera) {
   const float fwd = camera_bsdf.pdf(camera_si.wo, light_wo, TransportMode::Radiance);
   const float rev = camera_bsdf.pdf(light_wo, camera_si.wo, TransportMode::Importance);
   return rules.merge(light, camera, fwd, rev);

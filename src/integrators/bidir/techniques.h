@@ -1,7 +1,8 @@
-// The MIS weight of every way the bidirectional core completes a path, computed from the
+// The MIS terms of every way the bidirectional core completes a path, computed from the
 // vertices' hit records and BSDFs: the one place where geometry becomes the pdfs that MisRules
-// combines. The renderer and the tests' path replay (path_weights.h) both call these, so the
-// partition-of-unity test exercises exactly the code that renders.
+// combines. The weight is terms.weight(rules.counts()); adaptive-vcm also evaluates the same
+// terms under other counts. The renderer and the tests' path replay (path_weights.h) both call
+// these, so the partition-of-unity test exercises exactly the code that renders.
 #pragma once
 
 #include "core/vec.h"
@@ -37,25 +38,25 @@ void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteractio
 // Camera subpath reaches an emitter: an area light at `hit` (seen from prev_p) or, with hit ==
 // nullptr, an infinite light along dir (leaving prev_p). `camera` is the camera sums at the
 // emitter (after hit() for area lights, before it for infinite ones).
-float weight_emitter_hit(const MisRules& rules, const Light& light, float pmf, Vec3 prev_p,
-                         Vec3 dir, const SurfaceInteraction* hit, const MisSums& camera);
+TechniqueTerms terms_emitter_hit(const MisRules& rules, const Light& light, float pmf, Vec3 prev_p,
+                                 Vec3 dir, const SurfaceInteraction* hit, const MisSums& camera);
 // Next event estimation from camera vertex (si, bsdf) with wo.
-float weight_next_event(const MisRules& rules, const Light& light, float pmf,
-                        const LightLiSample& ls, const SurfaceInteraction& si, const Bsdf& bsdf,
-                        const MisSums& camera);
+TechniqueTerms terms_next_event(const MisRules& rules, const Light& light, float pmf,
+                                const LightLiSample& ls, const SurfaceInteraction& si,
+                                const Bsdf& bsdf, const MisSums& camera);
 // Connection of light vertex (light_si with its wo, BSDF, sums) and camera vertex.
-float weight_connection(const MisRules& rules, const SurfaceInteraction& light_si,
-                        const Bsdf& light_bsdf, Vec3 light_wo, const MisSums& light,
-                        const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
-                        const MisSums& camera);
+TechniqueTerms terms_connection(const MisRules& rules, const SurfaceInteraction& light_si,
+                                const Bsdf& light_bsdf, Vec3 light_wo, const MisSums& light,
+                                const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
+                                const MisSums& camera);
 // Light vertex connected to the lens point p_lens, splatted to a pixel whose camera technique
 // has raster density raster_density there (camera_pdf_w).
-float weight_light_to_camera(const MisRules& rules, const Camera& camera,
-                             const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
-                             const MisSums& light, Vec3 p_lens, float raster_density = 1.f);
+TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera,
+                                     const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
+                                     const MisSums& light, Vec3 p_lens, float raster_density = 1.f);
 // Merge of a light vertex that arrived along light_wo with a camera vertex.
-float weight_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,
-                   const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
-                   const MisSums& camera);
+TechniqueTerms terms_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,
+                           const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
+                           const MisSums& camera);
 
 }  // namespace caustica::bidir

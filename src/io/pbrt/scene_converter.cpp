@@ -100,12 +100,16 @@ void SceneConverter::require_world(const Directive& d, bool inside) const {
 
 void SceneConverter::add_shape_record(ShapeRecord record) {
   const ShapeGeometry& g = *record.geometry;
-  triangle_count_ += g.mesh ? g.mesh->triangle_count() : 1;
-  if (ctx_.max_triangles > 0 && triangle_count_ > ctx_.max_triangles)
-    throw SceneLoadError(record.where, "the scene has more than " +
-                                           std::to_string(ctx_.max_triangles) +
-                                           " triangles (the limit set for this load)");
+  count_triangles(g.mesh ? g.mesh->triangle_count() : 1, record.where);
   shapes_.push_back(std::move(record));
+}
+
+// Instanced triangles count as often as they are placed: the limit bounds rendering work too.
+void SceneConverter::count_triangles(size_t n, const SourceLocation& where) {
+  triangle_count_ += n;
+  if (ctx_.max_triangles > 0 && triangle_count_ > ctx_.max_triangles)
+    throw SceneLoadError(where, "the scene has more than " + std::to_string(ctx_.max_triangles) +
+                                    " triangles (the limit set for this load)");
 }
 
 void SceneConverter::finish() {
@@ -131,6 +135,7 @@ void SceneConverter::finish() {
       throw SceneLoadError(r.where, std::string("Shape: ") + e.what());
     }
   }
+  emit_instances();
   camera_.camera_to_world = camera_from_world_ ? camera_from_world_->inverse() : Transform();
   builder_.set_camera(camera_);
 }

@@ -4,13 +4,16 @@
 // Film, Sampler, Integrator) and the world (shapes, materials, textures, lights, objects).
 //
 // Materials are created after the whole file is read, as in pbrt-v4, so NamedMaterial may
-// refer to a material defined later. Object instances (ObjectBegin/End/ObjectInstance) are
-// flattened into world-space copies for now rather than Embree instances.
+// refer to a material defined later. An object (ObjectBegin/End) is stored once: its triangle
+// meshes become a prototype that each ObjectInstance places as an Embree instance; its spheres
+// and tessellated quadrics, whose exactness and orientation depend on the whole transform,
+// are copied into world space per instance.
 //
 // Each directive has one handler; a table (scene_converter.cpp) maps directive names to them and
 // says where each is allowed. The handlers live by meaning in scene_converter_state.cpp
 // (transformations, blocks, attributes), _options.cpp (Camera, Film, Sampler, ...), _world.cpp
-// (materials, textures, lights, shapes, objects); _shapes.cpp hands the shapes to the builder.
+// (materials, textures, lights, shapes, objects); _shapes.cpp hands the shapes to the builder,
+// _instances.cpp the objects' prototypes and instances.
 #pragma once
 
 #include <map>
@@ -66,6 +69,11 @@ class SceneConverter final : public DirectiveHandler {
     bool reverse_orientation = false;
     MaterialRef material;
     std::optional<AreaLightDesc> emission;
+    SourceLocation where;
+  };
+  struct InstanceRecord {  // one ObjectInstance of an object's triangle meshes
+    std::string object;
+    Transform object_to_world;
     SourceLocation where;
   };
 
@@ -125,11 +133,21 @@ class SceneConverter final : public DirectiveHandler {
   void require_world(const Directive& d, bool inside) const;
   ParamList with_attributes(const ParamList& params, const std::string& target) const;
   void add_shape_record(ShapeRecord record);
+  void count_triangles(size_t n, const SourceLocation& where);  // the max_triangles guard
 
   // Handing shapes to the builder (scene_converter_shapes.cpp).
   void emit_shape(const ShapeRecord& record);
   void emit_sphere(const ShapeRecord& record, const Sphere& sphere, const MaterialPtr& m);
   void emit_mesh(const ShapeRecord& record, TriangleMesh mesh, bool quadric, const MaterialPtr& m);
+
+  // Objects' prototypes and instances (scene_converter_instances.cpp).
+  static bool instanced(const ShapeRecord& record);  // placed by instances, not copied
+  struct PrototypeRef {
+    uint32_t index = 0;
+    Bounds3 bounds;  // object space
+  };
+  PrototypeRef emit_prototype(const std::vector<ShapeRecord>& shapes);
+  void emit_instances();
 
   SceneBuilder& builder_;
   LoaderContext& ctx_;
@@ -154,6 +172,7 @@ class SceneConverter final : public DirectiveHandler {
   std::vector<ShapeRecord> shapes_;
   std::map<std::string, std::vector<ShapeRecord>> objects_;
   std::optional<std::string> current_object_;
+  std::vector<InstanceRecord> instances_;
   size_t triangle_count_ = 0;
 };
 

@@ -2,6 +2,7 @@
 // instances. Materials are recorded here and created once the whole file is read (finish()),
 // so that NamedMaterial may refer to one defined later, as in pbrt-v4.
 #include "io/pbrt/scene_converter.h"
+#include "io/pbrt/transforms.h"
 
 namespace caustica::pbrt {
 
@@ -112,13 +113,29 @@ void SceneConverter::object_instance(const Directive& d) {
   if (it == objects_.end())
     throw SceneLoadError(d.arg_where[0],
                          "ObjectInstance: no object named " + quote_excerpt(d.args[0]));
-  // Flattened: each shape is copied into world space (world-from-instance times the
-  // shape's transform inside the definition), as pbrt-v4 composes them.
+  const Transform& world_from_instance = state_.ctm;
+  const Mat4& m = world_from_instance.matrix();
+  const bool affine = m(3, 0) == 0 && m(3, 1) == 0 && m(3, 2) == 0 && m(3, 3) == 1;
+  if (affine && !is_invertible(world_from_instance)) {
+    ctx_.warnings.warn(d.where, "ObjectInstance with a singular transformation skipped",
+                       "singular instance");
+    return;
+  }
+  // Copies are placed in world space as pbrt-v4 composes the transforms: world-from-instance
+  // times the shape's transform inside the definition. A projective placement (which Embree
+  // instances cannot express) copies every shape.
+  bool any_instanced = false;
   for (const ShapeRecord& s : it->second) {
+    if (affine && instanced(s)) {
+      count_triangles(s.geometry->mesh->triangle_count(), d.where);
+      any_instanced = true;
+      continue;
+    }
     ShapeRecord copy = s;
     copy.object_to_world = state_.ctm * s.object_to_world;
     add_shape_record(std::move(copy));
   }
+  if (any_instanced) instances_.push_back({d.args[0], world_from_instance, d.where});
 }
 
 void SceneConverter::media(const Directive& d) {

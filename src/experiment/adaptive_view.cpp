@@ -1,0 +1,68 @@
+#include "experiment/adaptive_view.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace caustica {
+
+namespace {
+
+std::string num(double v, const char* f) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+// The block-averaged merge mask as grey squares, scaled to at most 384 px wide.
+std::string mask_svg(const nlohmann::json& mask) {
+  const int w = mask["width"].get<int>(), h = mask["height"].get<int>();
+  const auto& fraction = mask["fraction"];
+  if (w <= 0 || h <= 0 || fraction.size() != size_t(w) * size_t(h)) return "";
+  const double cell = std::max(1.0, 384.0 / w);
+  std::ostringstream o;
+  o << "<svg class=\"mergemask\" xmlns=\"http://www.w3.org/2000/svg\" width=\"" << int(cell * w)
+    << "\" height=\"" << int(cell * h) << "\" shape-rendering=\"crispEdges\">";
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int g = int(255.0 * fraction[size_t(y) * w + x].get<double>() + 0.5);
+      o << "<rect x=\"" << num(x * cell, "%.1f") << "\" y=\"" << num(y * cell, "%.1f")
+        << "\" width=\"" << num(cell, "%.1f") << "\" height=\"" << num(cell, "%.1f")
+        << "\" fill=\"rgb(" << g << "," << g << "," << g << ")\"/>";
+    }
+  o << "</svg>";
+  return o.str();
+}
+
+}  // namespace
+
+std::string adaptive_choices_html(const ComparisonResult& result) {
+  std::ostringstream o;
+  for (const auto& run : result.runs) {
+    if (!run.integrator_stats.contains("adaptive")) continue;
+    const auto& a = run.integrator_stats["adaptive"];
+    o << "<h2>What " << run.integrator << " chose</h2>\n<table class=\"adaptive\"><thead><tr>"
+      << "<th>after probe</th><th>light paths / pixel</th><th>connections</th>"
+      << "<th>merging pixels</th><th>predicted relVar</th><th>cost (us / pixel)</th>"
+      << "</tr></thead><tbody>\n";
+    for (const auto& h : a["history"]) {
+      // The chosen row of the candidate table: the lowest score.
+      const nlohmann::json* best = nullptr;
+      for (const auto& c : h["candidates"])
+        if (!best || c["score"].get<double>() < (*best)["score"].get<double>()) best = &c;
+      o << "<tr><td>" << h["after_probe"].get<int>() << "</td><td>"
+        << num(h["light_path_factor"].get<double>(), "%g") << "</td><td>"
+        << h["connections"].get<int>() << "</td><td>"
+        << num(100 * h["merge_fraction"].get<double>(), "%.1f%%") << "</td><td>"
+        << (best ? num((*best)["relative_variance"].get<double>(), "%.4g") : "-") << "</td><td>"
+        << (best ? num((*best)["cost_us_per_pixel"].get<double>(), "%.3g") : "-") << "</td></tr>\n";
+    }
+    o << "</tbody></table>\n";
+    if (a.contains("merge_mask"))
+      o << "<p class=\"hint\">Merge mask (white: the pixel merges; blocks of "
+        << a["merge_mask"]["block"].get<int>() << " px):</p>\n"
+        << mask_svg(a["merge_mask"]) << "\n";
+  }
+  return o.str();
+}
+
+}  // namespace caustica

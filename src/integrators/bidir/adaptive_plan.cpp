@@ -1,0 +1,358 @@
+#include "integrators/bidir/adaptive_plan.h"
+
+#include <algorithm>
+#include <bit>
+#include <cassert>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "core/math.h"
+
+namespace caustica::bidir {
+
+namespace {
+// The fixed cost model, in microseconds per operation: a least-squares fit of camera-pass and
+// light-pass times to the operation counts (statistics "work_per_iteration") of vcm and bpt at
+// 1 and 4 connections and 0.25-2 light paths per pixel on door-ajar, cornell-box, veach-bidir
+// and water-caustic (1 thread, 2-core x86-64, g++ 12 Release, 2026-11-30; per scene the camera
+// vertex ranged 0.6-1.0 us, a connection 0.5-0.7, a light vertex 0.8-2.0). Scenes whose BSDFs
+// are expensive to evaluate (coated materials: material-testball fits 2.9 / 8.6 / 4.4) are
+// mispriced; --adaptive-costs measured times the probes instead. Used whenever costs are not
+// measured, so that a render at fixed spp and seed chooses the same configurations on every
+// machine and for every thread count.
+struct CostModel {
+  double camera_vertex = 0.75;  // trace, BSDF, NEE with its shadow ray
+  double light_vertex = 1.1;    // trace, BSDF, store, connect to the lens
+  double connection = 0.6;      // one light vertex connected to one camera vertex
+  double merge_query = 0.18;    // one range query
+  double photon = 0.03;         // one photon gathered
+};
+constexpr float kLightPathFactors[] = {0.25f, 0.5f, 1.f, 2.f};
+constexpr int kConnections[] = {0, 1, 2, 4};
+constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
+constexpr int kBlurRadius = 3;        // pixel variances pooled over 7 x 7 (box_blur)
+constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
+constexpr int kFirstProbes = 2;
+
+// The operation costs: the model, or what the probes measured (seconds summed over threads).
+CostModel costs_of(const ProbeWork& w, bool measured) {
+  CostModel t;
+  if (!measured) return t;
+  auto per = [](double seconds, double count, double fallback) {
+    return count > 0 && seconds > 0 ? 1e6 * seconds / count : fallback;
+  };
+  const double own_camera = w.camera_seconds - w.connect_seconds - w.merge_seconds;
+  t.camera_vertex = per(own_camera, w.camera_vertices, t.camera_vertex);
+  t.light_vertex = per(w.light_seconds, w.light_vertices, t.light_vertex);
+  t.connection = per(w.connect_seconds, w.connections, t.connection);
+  // Queries and photons share one clock: split it in the model's proportion.
+  const double model = w.merge_queries * t.merge_query + w.photons * t.photon;
+  if (model > 0 && w.merge_seconds > 0) {
+    const double scale = 1e6 * w.merge_seconds / model;
+    t.merge_query *= scale;
+    t.photon *= scale;
+  }
+  return t;
+}
+
+// Separable box filter of the given radius (clamped at the borders): a pixel's variance estimate
+// rests on a handful of probe samples; choosing per pixel between two such estimates picks the
+// luckier one (a caustic pixel whose probes missed the caustic stops merging). Neighbours share
+// their light transport, so their estimates are pooled.
+std::vector<double> box_blur(const std::vector<double>& in, int w, int h, int r) {
+  std::vector<double> tmp(in.size()), out(in.size());
+  auto pass = [r](const double* src, double* dst, int n, int stride) {
+    double sum = 0;
+    int count = 0;
+    for (int i = 0; i < std::min(r, n); ++i) sum += src[size_t(i) * stride], ++count;
+    for (int i = 0; i < n; ++i) {
+      if (i + r < n) sum += src[size_t(i + r) * stride], ++count;
+      if (i - r - 1 >= 0) sum -= src[size_t(i - r - 1) * stride], --count;
+      dst[size_t(i) * stride] = sum / count;
+    }
+  };
+  for (int y = 0; y < h; ++y) pass(&in[size_t(y) * w], &tmp[size_t(y) * w], w, 1);
+  for (int x = 0; x < w; ++x) pass(&tmp[x], &out[x], h, w);
+  return out;
+}
+
+// Per pixel and iteration, from the probes' work (light paths at one per pixel).
+struct PixelWork {
+  // connections: light vertices connected per pixel with one connection per camera vertex
+  // (the probes': depth limits and early rejections make it far fewer than vertices x vertices).
+  double camera_vertices, connections, light_vertices_per_path, merge_queries, photons;
+};
+
+double base_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
+  double cost = w.camera_vertices * t.camera_vertex;
+  if (c.light_path_factor > 0)
+    cost += c.light_path_factor * w.light_vertices_per_path * t.light_vertex +
+            c.connections * w.connections * t.connection;
+  return cost;
+}
+
+// Photon density grows with the light paths: photons per query scale with the factor.
+double merge_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
+  return w.merge_queries * t.merge_query + w.photons * c.light_path_factor * t.photon;
+}
+
+MisCounts counts_of(const AdaptivePlan::Candidate& c, size_t pixels, float radius) {
+  MisCounts n;
+  n.emitter = 1;
+  n.light_trace = c.light_path_factor * float(pixels);
+  n.connect = c.light_path_factor > 0 ? float(c.connections) : 0.f;
+  n.merge = c.merge ? n.light_trace * kPi * radius * radius : 0.f;
+  return n;
+}
+}  // namespace
+
+const std::vector<AdaptivePlan::Candidate>& AdaptivePlan::candidates() {
+  static const std::vector<Candidate> list = [] {
+    std::vector<Candidate> l{{0.f, 0, false}};  // path tracing
+    for (float f : kLightPathFactors)
+      for (int c : kConnections)
+        for (bool m : {false, true}) l.push_back({f, c, m});
+    return l;
+  }();
+  return list;
+}
+
+AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool probe_every_iteration)
+    : pixels_(size_t(width) * size_t(height)),
+      width_(width),
+      height_(height),
+      measured_(measured_costs),
+      probe_all_(probe_every_iteration),
+      moments_(pixels_ * kCandidates, 0.f),
+      merge_mask_(pixels_, 1) {
+  chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
+}
+
+bool AdaptivePlan::is_probe(uint32_t iteration) const {
+  // 0, 1, 3, 7, 15, 31, ...
+  return probe_all_ || iteration < kFirstProbes || std::has_single_bit(uint64_t(iteration) + 1);
+}
+
+IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
+  if (is_probe(iteration)) {
+    IterationPlan p;
+    p.light_paths = pixels_;
+    p.connections = 1;
+    p.merge_everywhere = true;
+    p.probe = true;
+    return p;
+  }
+  IterationPlan p = chosen_;
+  p.merge_mask = &merge_mask_;
+  return p;
+}
+
+void AdaptivePlan::begin_probe(float radius) {
+  light_sums_.assign(pixels_ * kCandidates, 0.f);
+  const std::vector<Candidate>& list = candidates();
+  for (size_t j = 0; j < kCandidates; ++j) {
+    const MisCounts n = counts_of(list[j], pixels_, radius);
+    // The emitter class always counts 1 (counts_of): it is added unscaled in add().
+    table_.light_trace[j] = n.light_trace;
+    table_.connect[j] = n.connect;
+    table_.merge[j] = n.merge;
+    table_.emitter[j] = n.emitter;
+  }
+}
+
+void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* terms,
+                       const MisCounts& counts) const {
+  if (!(value != 0.f) || !std::isfinite(value)) return;
+  if (!terms) {
+    for (size_t j = 0; j < kCandidates; ++j) sums.a[j] += value;
+    return;
+  }
+  // The probe's counts are all positive, so a finite Q means finite terms: plain arithmetic.
+  const float q = terms->denominator(counts), own = counts.of(terms->own);
+  if (!(q > 0) || !std::isfinite(q) || !(own > 0)) return;
+  const std::array<float, kCandidates>& own_count = table_.of(terms->own);
+  const float f2 = value * value, inv_own = 1.f / own;
+  for (size_t j = 0; j < kCandidates; ++j) {
+    const float q_candidate = own_count[j] + terms->emitter +
+                              table_.light_trace[j] * terms->light_trace +
+                              table_.connect[j] * terms->connect + table_.merge[j] * terms->merge;
+    // No technique of the candidate makes this path: it would miss the energy.
+    if (!(q_candidate > 0)) {
+      sums.d[j] = std::numeric_limits<float>::infinity();
+      continue;
+    }
+    const float ratio = q / q_candidate;
+    const float g = value * ratio * (own_count[j] * inv_own);
+    sums.a[j] += g;
+    sums.d[j] += f2 * ratio - g * g;
+  }
+}
+
+void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTerms* terms,
+                                   const MisCounts& counts) {
+  CandidateSums sums = pixel_start(pixel);
+  add(sums, value, terms, counts);
+  std::copy(sums.a.begin(), sums.a.end(), light_sums_.begin() + pixel * kCandidates);
+  float* m = &moments_[pixel * kCandidates];
+  for (size_t j = 0; j < kCandidates; ++j) m[j] += sums.d[j];
+}
+
+AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
+  CandidateSums sums;
+  std::copy_n(light_sums_.begin() + pixel * kCandidates, kCandidates, sums.a.begin());
+  return sums;
+}
+
+void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums) {
+  float* m = &moments_[pixel * kCandidates];
+  for (size_t j = 0; j < kCandidates; ++j) m[j] += sums.a[j] * sums.a[j] + sums.d[j];
+}
+
+void add_counts(ProbeWork& total, const ProbeWork& w) {
+  total.light_paths += w.light_paths;
+  total.light_vertices += w.light_vertices;
+  total.camera_vertices += w.camera_vertices;
+  total.nondelta_camera_vertices += w.nondelta_camera_vertices;
+  total.connections += w.connections;
+  total.merge_queries += w.merge_queries;
+  total.photons += w.photons;
+}
+
+void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means) {
+  ++probes_;
+  add_counts(work_, w);
+  work_.light_seconds += w.light_seconds;
+  work_.camera_seconds += w.camera_seconds;
+  work_.connect_seconds += w.connect_seconds;
+  work_.merge_seconds += w.merge_seconds;
+  // A choice needs the film's means (from the iterations before the probe) and two probes.
+  if (means.size() == pixels_ && (probes_ >= kFirstProbes || probe_all_)) choose(means);
+}
+
+double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means) const {
+  const double mean = means[p], moment = moments_[p * kCandidates + j] / double(probes_);
+  return std::max(moment - mean * mean, 0.0) / (mean * mean + kRelEps);
+}
+
+std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<float>& means) const {
+  // The part of a pixel's variance every candidate has (the least of them) is winsorised at its
+  // 99.5th percentile over the pixels: a firefly that a few probes saw in a handful of pixels,
+  // and that every candidate shares, is mostly estimation noise; at full weight it drowns the
+  // differences everywhere else and lets the cheapest candidate win. What a candidate has beyond
+  // the least (its own fireflies: missing connections, fewer light paths) is kept in full.
+  std::vector<double> shared(pixels_);
+  for (size_t p = 0; p < pixels_; ++p) {
+    double least = std::numeric_limits<double>::infinity();
+    for (size_t j = 0; j < kCandidates; ++j)
+      least = std::min(least, relative_variance(p, j, means));
+    shared[p] = least;
+  }
+  std::vector<double> sorted = shared;
+  const size_t q = std::min(pixels_ - 1, size_t(double(pixels_) * kWinsorize));
+  std::nth_element(sorted.begin(), sorted.begin() + q, sorted.end());
+  const double cap = sorted[q];
+  for (double& x : shared) x = x > cap ? cap - x : 0.0;
+  return shared;
+}
+
+std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector<float>& means,
+                                                     const std::vector<double>& correction) const {
+  std::vector<double> v(pixels_);
+  for (size_t p = 0; p < pixels_; ++p) v[p] = relative_variance(p, j, means) + correction[p];
+  return box_blur(v, width_, height_, kBlurRadius);
+}
+
+void AdaptivePlan::choose(const std::vector<float>& means) {
+  const std::vector<Candidate>& list = candidates();
+  const size_t k = list.size();
+  const double probes = double(probes_), pixels = double(pixels_);
+  const PixelWork pw{work_.camera_vertices / (probes * pixels),
+                     work_.connections / (probes * pixels),
+                     work_.light_paths > 0 ? work_.light_vertices / work_.light_paths : 0.0,
+                     work_.merge_queries / (probes * pixels), work_.photons / (probes * pixels)};
+  const CostModel t = costs_of(work_, measured_);
+  const std::vector<double> correction = shared_firefly_correction(means);
+  const std::vector<double> pt = relative_variances(0, means, correction);
+  double best = std::numeric_limits<double>::infinity();
+  size_t best_j = 0;
+  std::vector<uint8_t> mask(pixels_), best_mask(pixels_, 0);
+  nlohmann::json table = nlohmann::json::array();
+  // Candidates come in (no merge, merge) pairs after path tracing at index 0.
+  for (size_t j = 0; j < k; j += (j == 0 ? 1 : 2)) {
+    const Candidate& c = list[j];
+    const double cost = base_cost(c, pw, t);
+    const double extra = j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t);
+    const std::vector<double> no_merge = j == 0 ? pt : relative_variances(j, means, correction);
+    const std::vector<double> merge = j == 0 ? pt : relative_variances(j + 1, means, correction);
+    double variance = 0, total_cost = 0, variance0 = 0, variance1 = 0;
+    for (size_t p = 0; p < pixels_; ++p) {
+      const double v0 = no_merge[p], v1 = merge[p];
+      variance0 += v0;
+      variance1 += v1;
+      mask[p] = j != 0 && v1 * (cost + extra) < v0 * cost;
+      variance += mask[p] ? v1 : v0;
+      total_cost += mask[p] ? cost + extra : cost;
+    }
+    const double score = variance * total_cost;
+    table.push_back({{"light_path_factor", c.light_path_factor},
+                     {"connections", c.connections},
+                     {"merge_fraction",
+                      j == 0 ? 0.0 : double(std::count(mask.begin(), mask.end(), 1)) / pixels},
+                     {"relative_variance", variance / pixels},
+                     {"relative_variance_no_merge", variance0 / pixels},
+                     {"relative_variance_all_merge", variance1 / pixels},
+                     {"cost_us_per_pixel", total_cost / pixels},
+                     {"score", score}});
+    if (score < best) {
+      best = score;
+      best_j = j;
+      best_mask = mask;
+    }
+  }
+  const Candidate& c = list[best_j];
+  chosen_ = {};
+  chosen_.light_paths = uint64_t(std::llround(double(c.light_path_factor) * pixels));
+  chosen_.connections = c.connections;
+  chosen_.merge_everywhere = false;
+  merge_mask_ = best_mask;
+  history_.push_back(
+      {{"after_probe", probes_},
+       {"light_path_factor", c.light_path_factor},
+       {"connections", c.connections},
+       {"merge_fraction", double(std::count(best_mask.begin(), best_mask.end(), 1)) / pixels},
+       {"costs_us",
+        {{"camera_vertex", t.camera_vertex},
+         {"light_vertex", t.light_vertex},
+         {"connection", t.connection},
+         {"merge_query", t.merge_query},
+         {"photon", t.photon}}},
+       {"candidates", table}});
+}
+
+void AdaptivePlan::report(nlohmann::json& stats) const {
+  nlohmann::json a;
+  a["probes"] = probes_;
+  a["costs"] = measured_ ? "measured" : "model";
+  a["light_paths_per_iteration"] = chosen_.light_paths;
+  a["connections"] = chosen_.connections;
+  a["merge_fraction"] =
+      pixels_ ? double(std::count(merge_mask_.begin(), merge_mask_.end(), 1)) / double(pixels_)
+              : 0.0;
+  a["history"] = history_;
+  // The merge mask, block-averaged to at most 64 x 64 cells.
+  const int block = std::max(1, (std::max(width_, height_) + 63) / 64);
+  const int cw = (width_ + block - 1) / block, ch = (height_ + block - 1) / block;
+  std::vector<double> fraction(size_t(cw) * ch, 0.0), count(size_t(cw) * ch, 0.0);
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) {
+      const size_t cell = size_t(y / block) * cw + size_t(x / block);
+      fraction[cell] += merge_mask_[size_t(y) * width_ + x];
+      count[cell] += 1;
+    }
+  for (size_t i = 0; i < fraction.size(); ++i) fraction[i] /= std::max(count[i], 1.0);
+  a["merge_mask"] = {{"width", cw}, {"height", ch}, {"block", block}, {"fraction", fraction}};
+  stats["adaptive"] = a;
+}
+
+}  // namespace caustica::bidir

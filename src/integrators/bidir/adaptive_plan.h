@@ -1,0 +1,148 @@
+// The scene-adaptive configuration of the bidirectional core (adaptive-vcm), after Grittmann,
+// Yazici, Georgiev and Slusallek 2022, "Efficiency-Aware Multiple Importance Sampling for
+// Bidirectional Rendering Algorithms".
+//
+// A configuration is the number of light paths per iteration (0: path tracing with NEE and MIS,
+// up to 2x the pixel count), the number of light paths each camera vertex connects to
+// (0, 1, 2, 4) and, per pixel, whether the camera vertices merge. Probe iterations render full
+// VCM (one light path per pixel, one connection, merging everywhere) and record every
+// contribution F of every pixel with its MIS terms. Under the balance heuristic the second
+// moment of a pixel under counts n' is the integral of f^2 / sum_k n'_k p_k; the probe's samples
+// estimate it as sum F^2 * Q / Q', where Q and Q' are the MIS denominators of the sample's path
+// under the probe's and the candidate's counts (mis.h: TechniqueTerms::denominator). That is
+// the paper's proxy-weight correction factor: one probe prices every candidate, including ones
+// it never rendered. Correlation between techniques sharing a camera prefix is ignored.
+//
+// Cost: per candidate, the predicted time of an iteration from the probes' counts (camera
+// vertices, light vertices, connections, merge queries and photons) times per-operation costs,
+// either measured in the probes on this machine (non-deterministic, used with --time) or the
+// fixed model below (deterministic). The choice minimises sum_p relVar_p x cost: for each global
+// (light paths, connections) the merge mask takes, per pixel, the option of lower
+// variance x (pixel cost); then the global pair of lowest total wins.
+//
+// Probes are iterations 0, 1, 3, 7, 15, 31, ... (2^k - 1): their cost fades as the render
+// grows. The first choice is made after the second probe; the variance all candidates share
+// is winsorised at its 99.5th percentile over the pixels (a shared firefly must not decide) and
+// pooled over 7 x 7 neighbours before the per-pixel merge decision (a handful of samples per
+// pixel would otherwise decide by luck).
+// Every iteration, probe or not, is an unbiased (consistent, when merging) estimate of the
+// same image, and the film averages them. Deterministic at fixed spp and seed for any thread
+// count unless measured costs are asked for; one process only (learns while rendering).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "integrators/bidir/mis.h"
+
+namespace caustica::bidir {
+
+// What one iteration renders.
+struct IterationPlan {
+  uint64_t light_paths = 0;  // 0: camera paths only (path tracing)
+  int connections = 1;       // light paths each camera vertex connects to
+  bool merge_everywhere = true;
+  const std::vector<uint8_t>* merge_mask = nullptr;  // per pixel, when !merge_everywhere
+  bool probe = false;                                // record contributions for the planner
+  bool merges(size_t pixel) const {
+    return light_paths > 0 && (merge_everywhere || (merge_mask && (*merge_mask)[pixel]));
+  }
+};
+
+// Work counted in a probe iteration and, if measured, the seconds spent.
+struct ProbeWork {
+  double light_paths = 0, light_vertices = 0;
+  double camera_vertices = 0, nondelta_camera_vertices = 0;
+  double connections = 0;  // light vertices a camera vertex was connected to
+  double merge_queries = 0, photons = 0;
+  double light_seconds = 0, camera_seconds = 0, connect_seconds = 0, merge_seconds = 0;
+};
+
+// Adds w's operation counts (not its seconds) to total.
+void add_counts(ProbeWork& total, const ProbeWork& w);
+
+class AdaptivePlan {
+ public:
+  AdaptivePlan() = default;
+  AdaptivePlan(int width, int height, bool measured_costs, bool probe_every_iteration = false);
+
+  bool is_probe(uint32_t iteration) const;
+  IterationPlan plan(uint32_t iteration) const;
+
+  // Recording a probe. A pixel's estimate in a probe is the sum of its contributions F_i, each
+  // from a technique t_i of the probe's counts n. Under candidate counts n' the same path has
+  // the balance denominator Q'_i instead of Q_i. Per candidate the pixel keeps
+  //   A = sum G_i,  G_i = F_i (Q_i / Q'_i) (n'_t / n_t)  (mean-preserving: E[A] = the pixel value)
+  //   D = sum (F_i^2 Q_i / Q'_i - G_i^2)
+  // and A^2 + D estimates the candidate's second moment: its diagonal is the proxy correction
+  // sum F^2 Q / Q' (exact for independent samples), its cross terms those of the reweighted
+  // contributions, which share the camera path as the candidate's would. For the probe's own
+  // counts it is the sample's (sum F)^2. Light-tracing splats come first (add_light_trace, in a
+  // fixed order), then the pixel's task continues from pixel_start() with add() and hands the
+  // sums back with pixel_end().
+  static constexpr size_t kCandidates = 33;
+  struct CandidateSums {
+    std::array<float, kCandidates> a{}, d{};
+  };
+  // radius: the probe's merge radius (the candidates' merge counts N' pi r^2).
+  void begin_probe(float radius);
+  // terms == nullptr: a path only one technique makes (the same F under every candidate).
+  void add(CandidateSums& sums, float value, const TechniqueTerms* terms,
+           const MisCounts& counts) const;
+  void add_light_trace(size_t pixel, float value, const TechniqueTerms* terms,
+                       const MisCounts& counts);
+  CandidateSums pixel_start(size_t pixel) const;
+  void pixel_end(size_t pixel, const CandidateSums& sums);
+  // After a probe: its work, and the pixel means of the iterations before it (empty after the
+  // first; a mean from the probes alone makes a single sample look noiseless); re-optimises.
+  void finish_probe(const ProbeWork& work, const std::vector<float>& means);
+
+  // "adaptive": the configuration, the history of choices (each with its candidate table and
+  // costs) and the merge mask as the fraction of merging pixels in blocks of at most 64 x 64
+  // cells ("merge_mask": width, height, row-major "fraction").
+  void report(nlohmann::json& stats) const;
+  const std::vector<uint8_t>& merge_mask() const { return merge_mask_; }
+
+  struct Candidate {
+    float light_path_factor = 0;  // light paths / pixels
+    int connections = 0;
+    bool merge = false;
+  };
+  static const std::vector<Candidate>& candidates();
+
+ private:
+  // Pixel p's relative variance per iteration under candidate j.
+  double relative_variance(size_t p, size_t j, const std::vector<float>& means) const;
+  // Per pixel: what to add to every candidate's variance to winsorise the part they share.
+  std::vector<double> shared_firefly_correction(const std::vector<float>& means) const;
+  // Per pixel: candidate j's relative variance, corrected and pooled over neighbours.
+  std::vector<double> relative_variances(size_t j, const std::vector<float>& means,
+                                         const std::vector<double>& correction) const;
+  void choose(const std::vector<float>& means);
+
+  size_t pixels_ = 0;
+  int width_ = 0, height_ = 0;
+  bool measured_ = false;
+  bool probe_all_ = false;
+  std::vector<float> moments_;     // pixels x candidates: sum over probes of A^2 + D
+  std::vector<float> light_sums_;  // pixels x candidates: this probe's light-tracing A
+  // The candidates' counts per class for this probe's radius (structure of arrays).
+  struct CountTable {
+    std::array<float, kCandidates> emitter{}, light_trace{}, connect{}, merge{};
+    const std::array<float, kCandidates>& of(TechniqueClass c) const {
+      return c == TechniqueClass::Emitter      ? emitter
+             : c == TechniqueClass::LightTrace ? light_trace
+             : c == TechniqueClass::Connect    ? connect
+                                               : merge;
+    }
+  } table_;
+  int probes_ = 0;
+  ProbeWork work_;  // summed over probes
+  std::vector<uint8_t> merge_mask_;
+  IterationPlan chosen_;
+  std::vector<nlohmann::json> history_;
+};
+
+}  // namespace caustica::bidir

@@ -1,0 +1,261 @@
+// Camera subpaths of the bidirectional core (bidir_core.h): emitter hits, next event
+// estimation, connections to light subpaths and merging with light vertices, MIS-weighted.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+
+#include "integrators/bidir/bidir_core.h"
+#include "integrators/path_vertex.h"
+#include "lights/light.h"
+#include "lights/light_sampler.h"
+#include "materials/material.h"
+#include "scene/scene.h"
+
+namespace caustica::bidir {
+
+Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng,
+                              ScratchArena& arena, uint64_t* nonfinite) const {
+  PixelAccumulator acc;
+  acc.pixel = sample.pixel;
+  acc.filter_weight = sample.filter_weight;
+  if (techniques_.enabled()) acc.techniques = &techniques_;
+  const Iteration& it = current_;
+  acc.rules = it.plan.merges(sample.pixel) ? &it.rules : &it.rules_no_merge;
+  if (it.plan.probe) {
+    acc.plan = &plan_;
+    acc.candidate_sums = plan_.pixel_start(sample.pixel);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  camera_path(scene, it, sample, rng, acc, arena);
+  *nonfinite += acc.nonfinite;
+  if (it.plan.probe) {
+    plan_.pixel_end(sample.pixel, acc.candidate_sums);
+    if (settings_.bidir.measured_costs) acc.work.camera_seconds = seconds_since(start);
+  }
+  add_work(acc.work);
+  return acc.sum;
+}
+
+void BidirIntegrator::add_work(const ProbeWork& w) const {
+  std::lock_guard<std::mutex> lock(probe_mutex_);
+  add_counts(probe_, w);  // a pixel's work has no light paths or light vertices
+  probe_.camera_seconds += w.camera_seconds;
+  probe_.connect_seconds += w.connect_seconds;
+  probe_.merge_seconds += w.merge_seconds;
+}
+
+void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
+                                  const CameraSample& sample, Pcg32& rng, PixelAccumulator& acc,
+                                  ScratchArena& arena) const {
+  const Camera& camera = scene.camera();
+  const LightSampler& lights = scene.light_sampler();
+  const uint64_t pixel = sample.pixel;
+  Ray ray = sample.ray;
+  const float pdf_camera = camera_pdf_w(camera, ray.o, ray.d, sample.filter_pdf);
+  if (!(pdf_camera > 0)) return;
+  const MisRules& rules = *acc.rules;
+  MisSums mis = rules.camera_start(pdf_camera);
+  const int max_depth = settings_.max_depth;
+  const uint64_t light_path = it.light_path_of.light_path(pixel);
+
+  Rgb beta(1.f);
+  Vec3 prev_p = ray.o;
+  int depth = 0;              // surface vertices so far
+  bool specular_path = true;  // every bounce so far was specular
+  float segment = 0;
+  float eta_scale = 1;
+  // Emitters: MIS-weighted when connections take part, else only via delta-only chains.
+  TechniqueTerms terms;
+  bool weighted = false;  // the last emitter weight came from terms
+  auto emitter_weight = [&](const Light& light, const SurfaceInteraction* hit, const MisSums& m) {
+    weighted = false;
+    if (depth == 0) return 1.f;
+    if (!tech_.connect) return specular_path ? 1.f : 0.f;
+    weighted = true;
+    terms = terms_emitter_hit(rules, light, lights.pmf(&light), prev_p, ray.d, hit, m);
+    return terms.weight(rules.counts());
+  };
+
+  for (;;) {
+    SurfaceInteraction si;
+    if (!scene.intersect(ray, &si)) {
+      for_each_emitter_seen(scene.infinite_lights(), ray, nullptr, [&](const Light& l, Rgb Le) {
+        const float w = emitter_weight(l, nullptr, mis);
+        if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w, weighted ? &terms : nullptr);
+      });
+      break;
+    }
+    segment += si.t;
+    Bsdf bsdf;
+    if (si.material) bsdf = si.material->bsdf(si, arena);
+    MisSums at_hit = mis;
+    rules.hit(at_hit, segment * segment, geometric_cos(si, si.wo));
+
+    for_each_emitter_seen(scene.infinite_lights(), ray, &si, [&](const Light& l, Rgb Le) {
+      const float w = emitter_weight(l, &si, at_hit);
+      if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w, weighted ? &terms : nullptr);
+    });
+    if (!bsdf.valid()) {
+      ray = si.spawn_ray(ray.d);
+      continue;
+    }
+    ++depth;
+    mis = at_hit;
+    segment = 0;
+    if (depth > max_depth) break;
+
+    const bool delta = bsdf.is_delta();
+    ++acc.work.camera_vertices;
+    if (!delta)
+      vertex_techniques(scene, it, {si, bsdf, beta, mis, depth}, light_path, rng, arena, acc);
+
+    const float uc = rng.next_float();
+    const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Radiance);
+    if (!bs) break;
+    // PPM / lt: the non-delta part of this vertex was estimated by merging (or belongs to light
+    // tracing); only its delta lobes carry the camera path on.
+    if (tech_.camera_stops && !delta && !bs->is_specular()) break;
+    const float pdf_fwd =
+        bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Radiance) : bs->pdf;
+    scatter_update(rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Radiance, bs->is_specular(),
+                   pdf_fwd);
+    beta *= bs->f * (bsdf.abs_cos(bs->wi) / bs->pdf);
+    specular_path = specular_path && bs->is_specular();
+    if (bs->is_transmission()) eta_scale *= sqr(bs->eta);
+    if (beta.is_black()) break;
+    prev_p = si.p;
+    ray = si.spawn_ray(bs->wi);
+    if (!survives_russian_roulette(beta, eta_scale, depth, rng)) break;
+  }
+}
+
+void BidirIntegrator::vertex_techniques(const Scene& scene, const Iteration& it,
+                                        const CameraVertex& v, uint64_t light_path, Pcg32& rng,
+                                        ScratchArena& arena, PixelAccumulator& acc) const {
+  const MisRules& rules = *acc.rules;
+  const bool timed = acc.plan && settings_.bidir.measured_costs;
+  ++acc.work.nondelta_camera_vertices;
+  if (tech_.connect) {
+    next_event(scene, rules, v.si, v.bsdf, v.beta, v.mis, v.depth, rng, acc);
+    const auto t0 = timed ? std::chrono::steady_clock::now() : Clock::time_point{};
+    connect_to_light_paths(scene, it, rules, v.si, v.bsdf, v.beta, v.mis, v.depth, light_path, rng,
+                           arena, acc);
+    if (timed) acc.work.connect_seconds += seconds_since(t0);
+  }
+  if (tech_.merge && it.plan.merges(acc.pixel)) {
+    const auto t0 = timed ? std::chrono::steady_clock::now() : Clock::time_point{};
+    merge(scene, it, rules, v.si, v.bsdf, v.beta, v.mis, v.depth, acc);
+    if (timed) acc.work.merge_seconds += seconds_since(t0);
+  }
+}
+
+void BidirIntegrator::next_event(const Scene& scene, const MisRules& rules,
+                                 const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
+                                 const MisSums& mis, int depth, Pcg32& rng,
+                                 PixelAccumulator& acc) const {
+  const float u_light = rng.next_float();
+  const Vec2 u = rng.next_2d();
+  const auto d = sample_direct_light(scene, si, bsdf, u_light, u);
+  if (!d) return;
+  const TechniqueTerms terms = terms_next_event(rules, *d->light, d->pmf, d->ls, si, bsdf, mis);
+  const float w = terms.weight(rules.counts());
+  const Rgb value = beta * d->f * d->ls.radiance * (w / (d->pmf * d->ls.pdf_w));
+  if (value.is_black()) return;
+  if (scene.occluded(d->shadow)) return;
+  acc.add(false, 1, depth + 1, value, &terms);
+}
+
+void BidirIntegrator::connect_to_light_paths(const Scene& scene, const Iteration& it,
+                                             const MisRules& rules, const SurfaceInteraction& si,
+                                             const Bsdf& bsdf, Rgb beta, const MisSums& mis,
+                                             int depth, uint64_t light_path, Pcg32& rng,
+                                             ScratchArena& arena, PixelAccumulator& acc) const {
+  const uint64_t n = it.plan.light_paths;
+  const int c = it.plan.connections;
+  if (n == 0 || c == 0) return;
+  const Rgb scaled = beta / float(c);
+  for (int j = 0; j < c; ++j) {
+    const uint64_t path =
+        j == 0 ? light_path : std::min<uint64_t>(uint64_t(rng.next_float() * double(n)), n - 1);
+    connect_to_light_path(scene, rules, si, bsdf, scaled, mis, depth, path, arena, acc);
+  }
+}
+
+void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& rules,
+                                            const SurfaceInteraction& si, const Bsdf& bsdf,
+                                            Rgb beta, const MisSums& mis, int depth,
+                                            uint64_t light_path, ScratchArena& arena,
+                                            PixelAccumulator& acc) const {
+  for (uint32_t i = path_begin_[light_path]; i < path_begin_[light_path + 1]; ++i) {
+    const LightVertex& stored = vertices_[i];
+    // Stored in increasing depth: once too long, all the rest are too.
+    if (light_vertex_depth(stored) + depth > settings_.max_depth) break;
+    const LightVertexData v = unpack_light_vertex(stored);
+    const SurfaceInteraction light_si = scene.interaction_at(v.primitive, v.p, v.wo);
+    const Bsdf light_bsdf = light_si.material->bsdf(light_si, arena);
+    if (!light_bsdf.valid()) continue;
+    const Vec3 d = light_si.p - si.p;
+    const float dist2 = length_squared(d);
+    if (!(dist2 > 0)) continue;
+    const Vec3 dir = d / std::sqrt(dist2);
+    const Rgb f_camera = bsdf.f(si.wo, dir, TransportMode::Radiance) * bsdf.abs_cos(dir);
+    if (f_camera.is_black()) continue;
+    const Rgb f_light =
+        light_bsdf.f(v.wo, -dir, TransportMode::Importance) * light_bsdf.abs_cos(dir);
+    if (f_light.is_black()) continue;
+    ++acc.work.connections;
+    const TechniqueTerms terms =
+        terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf, mis);
+    const float w = terms.weight(rules.counts());
+    const Rgb value = beta * v.throughput * f_camera * f_light * (w / dist2);
+    if (value.is_black()) continue;
+    if (scene.occluded(spawn_ray_between(si, light_si))) continue;
+    acc.add(false, v.depth + 1, depth + 1, value, &terms);
+  }
+}
+
+void BidirIntegrator::merge(const Scene& scene, const Iteration& it, const MisRules& rules,
+                            const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
+                            const MisSums& mis, int depth, PixelAccumulator& acc) const {
+  ++acc.work.merge_queries;
+  const int max_depth = settings_.max_depth;
+  const Scene::PrimitiveRange own_shape = scene.shape_primitives(si);
+  const float max_off_plane = 0.5f * it.radius;
+  grid_.for_each_near(si.p, vertices_, [&](uint32_t index, Vec3 q) {
+    ++acc.work.photons;
+    const LightVertex& stored = vertices_[index];
+    const int light_depth = light_vertex_depth(stored);
+    if (light_depth + depth - 1 > max_depth) return;
+    if (std::abs(dot(q - si.p, si.ng)) > max_off_plane) return;
+    const LightVertexData v = unpack_light_vertex(stored);
+    // The photon's throughput carries the flux through the surface (geometric cosine); the
+    // camera vertex integrates with the shading cosine: |ns . wi| / |ng . wi|, as NEE and
+    // connections have it through abs_cos (Veach 1997, section 5.3).
+    const float cos_geometric = geometric_cos(si, v.wo);
+    if (!(cos_geometric > 0)) return;
+    const Rgb f =
+        bsdf.f(si.wo, v.wo, TransportMode::Radiance) * (bsdf.abs_cos(v.wo) / cos_geometric);
+    if (f.is_black()) return;
+    if (!own_shape.contains(v.primitive) &&
+        !photon_visible(scene, si, v.primitive, q, v.wo, it.radius))
+      return;
+    const TechniqueTerms terms = terms_merge(rules, v.wo, v.mis, si, bsdf, mis);
+    const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
+    acc.add(true, light_depth + 1, depth + 1,
+            beta * f * v.throughput * (w * it.merge_normalization), &terms);
+  });
+}
+
+bool BidirIntegrator::photon_visible(const Scene& scene, const SurfaceInteraction& si,
+                                     uint32_t primitive, Vec3 q, Vec3 wo, float radius) const {
+  const SurfaceInteraction photon = scene.interaction_at(primitive, q, wo);
+  const float tolerance = 1e-4f * radius;
+  const Vec3 n_query = face_forward(si.ng, wo), n_photon = face_forward(photon.ng, wo);
+  if (dot(q - si.p, n_query) < -tolerance || dot(si.p - q, n_photon) < -tolerance) return false;
+  const Vec3 origin = si.offset_origin(wo);
+  const Vec3 target = photon.offset_origin(wo);
+  return !scene.occluded({origin, target - origin, 1.f - 1e-6f});
+}
+
+}  // namespace caustica::bidir

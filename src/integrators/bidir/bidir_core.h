@@ -1,0 +1,264 @@
+// The bidirectional core's class, shared by its three source files (not an interface:
+// integrators outside bidir/ use bidir_integrator.h): bidir_integrator.cpp (iterations,
+// configuration, statistics), bidir_light_paths.cpp (light subpaths, their storage and the
+// light-tracing splats) and bidir_camera_paths.cpp (camera subpaths: NEE, connections, merging).
+#pragma once
+
+#include <chrono>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "core/arena.h"
+#include "core/rng.h"
+#include "film/pixel_filter.h"
+#include "image/image.h"
+#include "integrators/bidir/adaptive_plan.h"
+#include "integrators/bidir/bidir_integrator.h"
+#include "integrators/bidir/hash_grid.h"
+#include "integrators/bidir/light_path_assignment.h"
+#include "integrators/bidir/light_vertex.h"
+#include "integrators/bidir/technique_images.h"
+#include "integrators/bidir/techniques.h"
+#include "integrators/camera_path.h"
+
+namespace caustica::bidir {
+using Clock = std::chrono::steady_clock;
+
+// Light paths per chunk: at most 1024, fewer when that would leave fewer than 64 chunks (a small
+// image has few light paths; 4 chunks of 1024 kept 2 threads half idle at 64x64). It depends on
+// the path count only, never on the threads, and the vertices and splats are concatenated in
+// path order whatever the chunk size: the images do not depend on it.
+constexpr uint64_t kMaxChunkPaths = 1024, kMinChunkPaths = 64, kMinChunks = 64;
+inline uint64_t chunk_paths_for(uint64_t light_paths) {
+  return std::clamp((light_paths + kMinChunks - 1) / kMinChunks, kMinChunkPaths, kMaxChunkPaths);
+}
+constexpr float kDefaultRadiusFactor = 0.003f;
+
+// Which techniques take part (tech. rep. section 6, SmallVCM's switches).
+struct Techniques {
+  bool light_to_camera = false;  // t = 1 splats
+  bool connect = false;          // NEE, emitter hits and connections, MIS-weighted
+  bool merge = false;            // vertex merging
+  bool camera_stops = false;     // camera subpaths end at their first non-delta vertex
+  bool unweighted = false;       // single-technique estimators (lt, ppm): all weights 1
+  bool adaptive = false;         // configuration chosen per iteration (adaptive_plan.h)
+};
+
+struct Splat {
+  uint32_t pixel;
+  uint32_t technique;
+  Rgb value;
+};
+
+// Scalar of a contribution for the adaptive plan's moments.
+inline float scalar(Rgb v) { return (v.r + v.g + v.b) * (1.f / 3.f); }
+
+// What one chunk of light paths leaves behind.
+struct LightChunk {
+  uint64_t first_path = 0;
+  std::vector<LightVertex> vertices;
+  std::vector<uint32_t> path_ends;  // per path: vertices.size() after it
+  std::vector<Splat> splats;
+  std::vector<TechniqueTerms> splat_terms;  // probe iterations: each splat's MIS terms
+  uint64_t nonfinite = 0;
+  double seconds = 0;  // probe iterations: time spent tracing the chunk
+};
+
+// Per-iteration constants.
+struct Iteration {
+  uint32_t index = 0;
+  IterationPlan plan;  // light paths, connections, merging
+  float radius = 0;
+  MisRules rules{MisHeuristic::Balance, false, false, 1, 0};
+  MisRules rules_no_merge = rules;    // in pixels that do not merge (adaptive-vcm)
+  float merge_normalization = 0;      // 1 / (N pi r^2)
+  LightPathAssignment light_path_of;  // pixel -> the light subpath it connects to
+};
+
+// A value added to the pixel and, if technique images are kept, to its technique.
+struct PixelAccumulator {
+  Rgb sum;
+  TechniqueImages* techniques = nullptr;
+  size_t pixel = 0;
+  uint64_t nonfinite = 0;
+  float filter_weight = 1;  // the camera sample's pixel-filter weight (pixel_filter.h)
+  // Probe iterations of adaptive-vcm: each contribution with its MIS terms, and the work.
+  AdaptivePlan* plan = nullptr;
+  AdaptivePlan::CandidateSums candidate_sums;
+  const MisRules* rules = nullptr;
+  ProbeWork work;
+  // sum is the estimate before the filter weight (the seam applies it); technique images get
+  // each value already weighted, so that they add up to the image. terms: the value's MIS
+  // terms (nullptr: a path only one technique makes).
+  void add(bool merge, int s, int t, Rgb value, const TechniqueTerms* terms = nullptr) {
+    if (!value.is_finite()) {
+      ++nonfinite;
+      return;
+    }
+    sum += value;
+    if (techniques)
+      techniques->add(TechniqueImages::key(merge, s, t), pixel, value * filter_weight);
+    if (plan) plan->add(candidate_sums, scalar(value * filter_weight), terms, rules->counts());
+  }
+};
+
+inline double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Techniques techniques_of(BidirAlgorithm a);
+const char* name_of(BidirAlgorithm a);
+
+class BidirIntegrator final : public CameraPathIntegrator {
+ public:
+  BidirIntegrator(BidirAlgorithm algorithm, const IntegratorSettings& settings)
+      : CameraPathIntegrator(hash_combine(settings.seed, 0xca3e7aull)),
+        algorithm_(algorithm),
+        tech_(techniques_of(algorithm)),
+        settings_(settings) {
+    heuristic_ = settings.mis_or(MisHeuristic::Balance);
+  }
+  const char* name() const override { return name_of(algorithm_); }
+
+  void prepare(const Scene& scene, Film& film) override;
+
+  void render_iteration(const Scene& scene, uint32_t iteration, Film& film) override;
+
+  void finish(const Scene&, Film& film) override;
+
+  void report(nlohmann::json& stats) const override;
+
+ private:
+  bool stores_vertices() const { return tech_.connect || tech_.merge; }
+
+  // Scalar pixel means of the film's completed iterations (empty before the first); between
+  // iterations only (film.h).
+  static std::vector<float> pixel_means(const Film& film);
+
+  // Chunks for n light paths (chunk_paths_for).
+  void size_chunks(uint64_t n);
+
+  // ---- light subpaths -----------------------------------------------------------------------
+  // Chunks are traced in parallel into a few reused buffers and appended, in chunk order, to
+  // vertices_ and the splat image as they finish (a pipeline whose last stage is serial and in
+  // order): no chunk is kept once appended, so the vertices are held once, not per chunk and
+  // again concatenated, and the result is the concatenation in path order for any threads.
+  void trace_light_paths(const Scene& scene, const Iteration& it, Film& film);
+
+  // Light paths of chunk c, traced into chunk (its storage reused).
+  void trace_chunk(const Scene& scene, const Iteration& it, uint64_t c, LightChunk& chunk) const;
+
+  // The next chunk in path order: vertex i of path p lands at path_begin_[p] + i; its splats
+  // are added in the order they were made (deterministic sums).
+  void append_chunk(const Iteration& it, const LightChunk& chunk);
+
+  void trace_light_path(const Scene& scene, const Iteration& it, uint64_t path, LightChunk& chunk,
+                        ScratchArena& arena) const;
+
+  // t = 1: the light vertex seen through a lens point; splat recorded in the chunk.
+  void connect_to_camera(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
+                         const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth, Pcg32& rng,
+                         LightChunk& chunk) const;
+
+  // ---- camera subpaths ----------------------------------------------------------------------
+  // The seam's per-pixel call: the camera subpath of this iteration (current_).
+  Rgb estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng, ScratchArena& arena,
+               uint64_t* nonfinite) const override;
+
+  // A pixel's work, into this iteration's (probe_).
+  void add_work(const ProbeWork& w) const;
+
+  void camera_path(const Scene& scene, const Iteration& it, const CameraSample& sample, Pcg32& rng,
+                   PixelAccumulator& acc, ScratchArena& arena) const;
+
+  // The techniques at a non-delta camera vertex: NEE, connections, merging.
+  struct CameraVertex {
+    const SurfaceInteraction& si;
+    const Bsdf& bsdf;
+    Rgb beta;
+    const MisSums& mis;
+    int depth;
+  };
+  void vertex_techniques(const Scene& scene, const Iteration& it, const CameraVertex& v,
+                         uint64_t light_path, Pcg32& rng, ScratchArena& arena,
+                         PixelAccumulator& acc) const;
+
+  void next_event(const Scene& scene, const MisRules& rules, const SurfaceInteraction& si,
+                  const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth, Pcg32& rng,
+                  PixelAccumulator& acc) const;
+
+  // Connections to the vertices of `connections` light paths: the pixel's own, then paths drawn
+  // uniformly (each light path is an independent sample, so any choice is unbiased); each
+  // connection is one of c samples, hence the 1 / c.
+  void connect_to_light_paths(const Scene& scene, const Iteration& it, const MisRules& rules,
+                              const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
+                              const MisSums& mis, int depth, uint64_t light_path, Pcg32& rng,
+                              ScratchArena& arena, PixelAccumulator& acc) const;
+
+  void connect_to_light_path(const Scene& scene, const MisRules& rules,
+                             const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
+                             const MisSums& mis, int depth, uint64_t light_path,
+                             ScratchArena& arena, PixelAccumulator& acc) const;
+
+  // Merging accepts a photon only if light could have reached the query's surface through it
+  // (no leaks through zero-thickness walls):
+  //  - it lies within half the radius of the query's tangent plane (a photon on another sheet
+  //    of the same mesh, or behind a corner, is not density on this surface);
+  //  - it arrived on a side the query's BSDF scatters from (f = 0 otherwise);
+  //  - a photon on another shape (mesh or sphere) than the query must see the query: one shadow
+  //    ray from the query to a point just off the photon on the side it arrived from. Photons
+  //    on the query's own shape are trusted, so the ray is traced only near shape boundaries.
+  // Each test only removes photons; at distance 0 (the partition test's merges) all pass.
+  void merge(const Scene& scene, const Iteration& it, const MisRules& rules,
+             const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta, const MisSums& mis,
+             int depth, PixelAccumulator& acc) const;
+
+  // Whether light arriving along wo at the query could be the photon's (a photon on another
+  // shape than the query). Each point must lie on the lit side (the side of wo) of the other's
+  // surface, within a ten-thousandth of the radius: a photon on the far face of a
+  // zero-thickness wall, or a query behind the photon's wall, fails here. Then a shadow ray
+  // between the two, each end offset off its own surface to the side of wo, catches a wall
+  // between them (a floor continuing under the wall into the next room). The photon's hit
+  // record is rebuilt for its normal and error bounds.
+  bool photon_visible(const Scene& scene, const SurfaceInteraction& si, uint32_t primitive, Vec3 q,
+                      Vec3 wo, float radius) const;
+
+  BidirAlgorithm algorithm_;
+  Techniques tech_;
+  IntegratorSettings settings_;
+  MisHeuristic heuristic_;
+  PixelFilter filter_;  // the scene camera's, set by prepare(): light-tracing splats
+  Iteration current_;   // this iteration's constants, for estimate()
+  float base_radius_ = 0, last_radius_ = 0;
+  uint64_t light_paths_ = 0;
+
+  // Per-iteration buffers, reused.
+  uint64_t chunk_paths_ = kMaxChunkPaths;  // light paths per chunk (chunk_paths_for)
+  uint64_t chunk_count_ = 0;
+  std::vector<LightChunk> chunk_buffers_;  // one per chunk in flight (trace_light_paths)
+  double light_chunk_seconds_ = 0;         // probe iterations: the chunks' tracing times, summed
+  std::vector<LightVertex> vertices_;
+  std::vector<uint32_t> path_begin_;
+  HashGrid grid_;
+  Image splat_image_;
+  // Written by the camera pass (estimate() is const): each pixel by the one task that owns it.
+  mutable TechniqueImages techniques_;
+
+  // Statistics.
+  uint32_t iterations_ = 0;
+  uint64_t vertices_total_ = 0;
+  double seconds_total_ = 0;
+  double grid_seconds_total_ = 0;    // of seconds_total_, building the hash grid
+  double light_seconds_total_ = 0;   // of seconds_total_, tracing light paths (with their splats)
+  double camera_seconds_total_ = 0;  // of seconds_total_, tracing camera paths
+  ProbeWork work_total_;             // operations counted over all iterations (counts only)
+  std::vector<std::string> technique_files_;
+
+  // adaptive-vcm: the plan, and the work of the current probe iteration.
+  mutable AdaptivePlan plan_;
+  mutable ProbeWork probe_;  // this iteration's work
+  mutable std::mutex probe_mutex_;
+};
+
+}  // namespace caustica::bidir

@@ -1,0 +1,233 @@
+// Light subpaths of the bidirectional core (bidir_core.h): traced in chunks, their non-delta
+// vertices stored (light_vertex.h) and, for light tracing, connected to the lens.
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "film/film.h"
+#include "integrators/bidir/bidir_core.h"
+#include "lights/light.h"
+#include "lights/light_sampler.h"
+#include "materials/material.h"
+#include "scene/scene.h"
+
+namespace caustica::bidir {
+
+namespace {
+
+Ray ray_leaving_light(const LightLeSample& le, const Light& light) {
+  if (light.type() == LightType::Area) {
+    // The emission point lies on the light's surface: nudge it to the emitting side.
+    const Vec3 side = face_forward(le.n, le.dir);
+    const float eps = 1e-4f * std::max(1.f, max_component(abs(le.p)));
+    return {le.p + side * eps, le.dir, kInfinity};
+  }
+  return {le.p, le.dir, kInfinity};
+}
+
+}  // namespace
+
+void BidirIntegrator::trace_light_paths(const Scene& scene, const Iteration& it, Film& film) {
+  const auto start = std::chrono::steady_clock::now();
+  vertices_.clear();
+  path_begin_.resize(it.plan.light_paths + 1);
+  light_chunk_seconds_ = 0;
+  if (tech_.light_to_camera) {
+    if (splat_image_.width() != film.width()) splat_image_ = Image(film.width(), film.height());
+    std::fill(splat_image_.pixels().begin(), splat_image_.pixels().end(), Rgb(0.f));
+  }
+  const size_t tokens = std::min<size_t>(
+      chunk_count_, 4 * size_t(std::max(1, tbb::this_task_arena::max_concurrency())));
+  if (chunk_buffers_.size() < tokens) chunk_buffers_.resize(tokens);
+  std::vector<LightChunk*> free_buffers;
+  for (size_t i = 0; i < tokens; ++i) free_buffers.push_back(&chunk_buffers_[i]);
+  std::mutex free_mutex;
+  uint64_t next_chunk = 0, nonfinite = 0;
+  if (tokens > 0)
+    tbb::parallel_pipeline(tokens,
+                           tbb::make_filter<void, uint64_t>(tbb::filter_mode::serial_in_order,
+                                                            [&](tbb::flow_control& fc) -> uint64_t {
+                                                              if (next_chunk == chunk_count_)
+                                                                fc.stop();
+                                                              return next_chunk++;
+                                                            }) &
+                               tbb::make_filter<uint64_t, LightChunk*>(
+                                   tbb::filter_mode::parallel,
+                                   [&](uint64_t c) {
+                                     LightChunk* chunk;
+                                     {
+                                       const std::lock_guard<std::mutex> lock(free_mutex);
+                                       chunk = free_buffers.back();
+                                       free_buffers.pop_back();
+                                     }
+                                     trace_chunk(scene, it, c, *chunk);
+                                     return chunk;
+                                   }) &
+                               tbb::make_filter<LightChunk*, void>(
+                                   tbb::filter_mode::serial_in_order, [&](LightChunk* chunk) {
+                                     append_chunk(it, *chunk);
+                                     nonfinite += chunk->nonfinite;
+                                     const std::lock_guard<std::mutex> lock(free_mutex);
+                                     free_buffers.push_back(chunk);
+                                   }));
+  path_begin_[it.plan.light_paths] = uint32_t(vertices_.size());
+  if (tech_.light_to_camera) {
+    if (nonfinite) film.count_nonfinite(nonfinite);
+    film.add_image(splat_image_);
+  }
+  light_seconds_total_ += seconds_since(start);
+}
+
+void BidirIntegrator::trace_chunk(const Scene& scene, const Iteration& it, uint64_t c,
+                                  LightChunk& chunk) const {
+  thread_local ScratchArena arena;
+  chunk.vertices.clear();
+  chunk.path_ends.clear();
+  chunk.splats.clear();
+  chunk.splat_terms.clear();
+  chunk.nonfinite = 0;
+  const auto chunk_start = std::chrono::steady_clock::now();
+  chunk.first_path = c * chunk_paths_;
+  const uint64_t last = std::min<uint64_t>(chunk.first_path + chunk_paths_, it.plan.light_paths);
+  for (uint64_t path = chunk.first_path; path < last; ++path) {
+    arena.reset();
+    trace_light_path(scene, it, path, chunk, arena);
+    chunk.path_ends.push_back(uint32_t(chunk.vertices.size()));
+  }
+  chunk.seconds = it.plan.probe && settings_.bidir.measured_costs ? seconds_since(chunk_start) : 0;
+}
+
+void BidirIntegrator::append_chunk(const Iteration& it, const LightChunk& chunk) {
+  const size_t need = vertices_.size() + chunk.vertices.size();
+  if (need > vertices_.capacity()) {
+    // Grow to what the chunks so far predict for the whole iteration, plus a tenth, rather
+    // than by doubling: this is the largest buffer, kept from one iteration to the next.
+    const uint64_t chunks_done = chunk.first_path / chunk_paths_ + 1;
+    const size_t predicted = size_t(double(need) * double(chunk_count_) / double(chunks_done));
+    vertices_.reserve(std::max(need, predicted + predicted / 10));
+  }
+  const uint32_t base = uint32_t(vertices_.size());
+  vertices_.insert(vertices_.end(), chunk.vertices.begin(), chunk.vertices.end());
+  for (size_t i = 0; i < chunk.path_ends.size(); ++i)
+    path_begin_[chunk.first_path + i] = base + (i ? chunk.path_ends[i - 1] : 0);
+  light_chunk_seconds_ += chunk.seconds;
+  for (size_t i = 0; i < chunk.splats.size(); ++i) {
+    const Splat& s = chunk.splats[i];
+    splat_image_[s.pixel] += s.value;
+    if (techniques_.enabled()) techniques_.add(s.technique, s.pixel, s.value);
+    if (it.plan.probe)
+      plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[i], it.rules.counts());
+  }
+}
+
+void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, uint64_t path,
+                                       LightChunk& chunk, ScratchArena& arena) const {
+  const LightSampler& sampler = scene.light_sampler();
+  if (sampler.empty()) return;
+  Pcg32 rng = Pcg32::for_sample(path, it.index, hash_combine(settings_.seed, 0x11947ull));
+  float pmf;
+  const Light* light = sampler.sample(rng.next_float(), &pmf);
+  const Vec2 u_pos = rng.next_2d(), u_dir = rng.next_2d();
+  if (!light || !(pmf > 0)) return;
+  const auto le = light->sample_le(u_pos, u_dir);
+  if (!le || !(le->pdf_pos > 0) || !(le->pdf_dir > 0) || le->radiance.is_black()) return;
+  const float emission_pdf = pmf * le->pdf_pos * le->pdf_dir;
+  Rgb beta = le->radiance * (le->cos_at_light / emission_pdf);
+  const float beta_start = beta.max_component();
+  const int max_depth = settings_.max_depth;
+
+  Ray ray = ray_leaving_light(*le, *light);
+  MisSums mis;
+  float segment = 0;  // distance since the previous real vertex (interfaces are skipped)
+  int depth = 0;
+  for (;;) {
+    SurfaceInteraction si;
+    if (!scene.intersect(ray, &si)) break;
+    segment += si.t;
+    Bsdf bsdf;
+    if (si.material) bsdf = si.material->bsdf(si, arena);
+    if (!bsdf.valid()) {
+      ray = si.spawn_ray(ray.d);
+      continue;
+    }
+    ++depth;
+    if (depth == 1) {
+      mis = light_subpath_start(it.rules, *light, pmf, *le, si, segment);
+    } else {
+      it.rules.hit(mis, segment * segment, geometric_cos(si, si.wo));
+    }
+    segment = 0;
+    if (depth > max_depth) break;
+
+    if (!bsdf.is_delta()) {
+      if (stores_vertices()) {
+        chunk.vertices.push_back(
+            pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}));
+      }
+      if (tech_.light_to_camera)
+        connect_to_camera(scene, it, si, bsdf, beta, mis, depth, rng, chunk);
+    }
+    if (depth + 1 > max_depth) break;
+
+    const float uc = rng.next_float();
+    const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Importance);
+    if (!bs) break;
+    const float pdf_fwd =
+        bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Importance) : bs->pdf;
+    scatter_update(it.rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Importance,
+                   bs->is_specular(), pdf_fwd);
+    beta *= bs->f * (bsdf.abs_cos(bs->wi) / bs->pdf);
+    if (beta.is_black()) break;
+    ray = si.spawn_ray(bs->wi);
+    // Russian roulette on the throughput relative to the emitted one (importance carries no
+    // radiance scaling at refractions, so no eta correction).
+    const float rr = beta.max_component() / beta_start;
+    if (rr < 1 && depth > 1) {
+      const float q = std::max(0.f, 1 - rr);
+      if (rng.next_float() < q) break;
+      beta = beta / (1 - q);
+    }
+  }
+}
+
+void BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
+                                        const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
+                                        const MisSums& mis, int depth, Pcg32& rng,
+                                        LightChunk& chunk) const {
+  const Camera& camera = scene.camera();
+  const auto cs = camera.sample_wi(si.p, rng.next_2d());
+  if (!cs || !(cs->importance > 0)) return;
+  const Rgb f = bsdf.f(si.wo, cs->wi, TransportMode::Importance) * bsdf.abs_cos(cs->wi);
+  if (f.is_black()) return;
+  // Pixel importance is pixel_count * We * f(r - c_p) / integral f; each pixel is estimated by
+  // N light paths. Every pixel whose filter support holds the raster point r gets a splat,
+  // MIS-weighted against its own camera technique (raster density pdf(r - c_p)).
+  const float scale =
+      cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(it.plan.light_paths));
+  const size_t first_splat = chunk.splats.size();
+  filter_.for_each_pixel(
+      cs->raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
+        const uint32_t pixel = uint32_t(y * camera.width() + x);
+        const MisRules& rules = it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
+        const TechniqueTerms terms =
+            terms_light_to_camera(rules, camera, si, bsdf, si.wo, mis, cs->p_lens, fs.pdf);
+        const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
+        const Rgb value = beta * f * (scale * w) * (fs.weight * fs.pdf);
+        if (value.is_black()) return;
+        if (!value.is_finite()) {
+          ++chunk.nonfinite;
+          return;
+        }
+        chunk.splats.push_back({pixel, TechniqueImages::key(false, depth + 1, 1), value});
+        if (it.plan.probe) chunk.splat_terms.push_back(terms);
+      });
+  if (chunk.splats.size() > first_splat && scene.occluded(si.spawn_ray_to(cs->p_lens))) {
+    chunk.splats.resize(first_splat);
+    if (it.plan.probe) chunk.splat_terms.resize(first_splat);
+  }
+}
+
+}  // namespace caustica::bidir

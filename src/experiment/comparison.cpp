@@ -108,6 +108,7 @@ double time_to_rel_mse(const IntegratorRun& run, double target) {
   if (s.empty() || !(target > 0)) return -1;
   for (size_t i = 0; i < s.size(); ++i) {
     if (s[i].errors.rel_mse <= target) {
+      if (s[i].errors.rel_mse == target) return s[i].seconds;  // exp(log(t)) need not give t
       if (i == 0)
         return s[0].seconds * s[0].errors.rel_mse / target;  // ~1/t before the first point
       // Log-log interpolation between snapshots i-1 and i.

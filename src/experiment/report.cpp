@@ -23,7 +23,9 @@ nlohmann::json comparison_summary(const ComparisonResult& result) {
                           {"iterations", r.iterations},
                           {"rays_per_second", r.seconds > 0 ? double(r.rays) / r.seconds : 0.0},
                           {"errors", to_json(e)}};
-    if (pt && r.seconds > 0) {
+    if (pt == &r) {
+      row["speedup_vs_pt"] = 1.0;  // by definition (its own curve is not monotonic)
+    } else if (pt && r.seconds > 0) {
       const double t = time_to_rel_mse(*pt, e.rel_mse);
       if (t > 0)
         row["speedup_vs_pt"] = t / r.seconds;

@@ -208,12 +208,6 @@ int GuidedPathTracer::training_pass(uint32_t iteration) {
   return std::bit_width(uint64_t(iteration) + 1) - 1;
 }
 
-float GuidedPathTracer::mis_weight(float pdf_a, float pdf_b) const {
-  return settings_.mis_or(MisHeuristic::Power) == MisHeuristic::Power
-             ? power_heuristic(pdf_a, pdf_b)
-             : balance_heuristic(pdf_a, pdf_b);
-}
-
 void GuidedPathTracer::prepare(const Scene& scene, Film& film) {
   CameraPathIntegrator::prepare(scene, film);
   field_ = GuidingField(scene.bounds(), settings_.guiding);
@@ -256,7 +250,7 @@ Image GuidedPathTracer::image(const Film& film) const {
 
 Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng,
                                ScratchArena& arena, uint64_t*) const {
-  const LightSampler& lights = scene.light_sampler();
+  const MisHeuristic heuristic = settings_.mis_or(MisHeuristic::Power);
   PathLearning learning(arena, settings_.max_depth, sample.pixel, records_.local());
   std::vector<uint32_t>& vertex_counts = vertex_counts_.local();
   if (vertex_counts.size() != field_.leaf_count()) vertex_counts.assign(field_.leaf_count(), 0);
@@ -274,12 +268,8 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     learning.contribute(c);
   };
   auto add_emission = [&](const SurfaceInteraction* hit) {
-    for_each_emitter_seen(scene.infinite_lights(), ray, hit, [&](const Light& light, Rgb Le) {
-      if (depth == 0 || specular_bounce)
-        add(beta * Le);
-      else
-        add(beta * Le * mis_weight(prev_pdf, next_event_pdf(lights, light, prev_p, ray.d, hit)));
-    });
+    add_emission_seen(scene, ray, hit, depth == 0 || specular_bounce, prev_pdf, prev_p, heuristic,
+                      [&](Rgb Le, float w) { add(beta * Le * w); });
   };
 
   for (;;) {
@@ -305,7 +295,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     NextEventSeen seen;
     add(direct_light_mis(
         scene, si, bsdf, beta, u_light, u, mixture_pdf,
-        [&](float a, float b) { return mis_weight(a, b); }, &seen));
+        [&](float a, float b) { return mis_weight(heuristic, a, b); }, &seen));
     if (mix.guidable && !seen.Li.is_black())
       learning.add_next_event(mix, seen,
                               nee_evaluated ? nee_pdfs : mix.evaluate(bsdf, wo, seen.wi));

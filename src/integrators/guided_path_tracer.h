@@ -76,8 +76,6 @@ class GuidedPathTracer final : public CameraPathIntegrator {
                uint64_t* nonfinite) const override;
 
  private:
-  float mis_weight(float pdf_a, float pdf_b) const;
-
   IntegratorSettings settings_;
   GuidingField field_;
   int pass_ = 0;

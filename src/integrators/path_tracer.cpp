@@ -8,15 +8,9 @@
 
 namespace caustica {
 
-float PathTracer::mis_weight(float pdf_a, float pdf_b) const {
-  return settings_.mis_or(MisHeuristic::Power) == MisHeuristic::Power
-             ? power_heuristic(pdf_a, pdf_b)
-             : balance_heuristic(pdf_a, pdf_b);
-}
-
 Rgb PathTracer::radiance(const Scene& scene, const Ray& camera_ray, Pcg32& rng,
                          ScratchArena& arena) const {
-  const LightSampler& lights = scene.light_sampler();
+  const MisHeuristic heuristic = settings_.mis_or(MisHeuristic::Power);
   Rgb L(0.f), beta(1.f);
   Ray ray = camera_ray;
   int depth = 0;
@@ -27,12 +21,8 @@ Rgb PathTracer::radiance(const Scene& scene, const Ray& camera_ray, Pcg32& rng,
 
   // Emission seen by this ray: full weight after delta bounces, MIS-weighted otherwise.
   auto add_emission = [&](const SurfaceInteraction* hit) {
-    for_each_emitter_seen(scene.infinite_lights(), ray, hit, [&](const Light& light, Rgb Le) {
-      if (depth == 0 || specular_bounce)
-        L += beta * Le;
-      else
-        L += beta * Le * mis_weight(prev_pdf, next_event_pdf(lights, light, prev_p, ray.d, hit));
-    });
+    add_emission_seen(scene, ray, hit, depth == 0 || specular_bounce, prev_pdf, prev_p, heuristic,
+                      [&](Rgb Le, float w) { L += beta * Le * w; });
   };
 
   for (;;) {
@@ -49,7 +39,7 @@ Rgb PathTracer::radiance(const Scene& scene, const Ray& camera_ray, Pcg32& rng,
     L += direct_light_mis(
         scene, si, bsdf, beta, u_light, u,
         [&](Vec3 wi) { return bsdf.pdf(wo, wi, TransportMode::Radiance); },
-        [&](float a, float b) { return mis_weight(a, b); });
+        [&](float a, float b) { return mis_weight(heuristic, a, b); });
 
     const float uc = rng.next_float();
     const auto bs = bsdf.sample(wo, uc, rng.next_2d(), TransportMode::Radiance);

@@ -23,7 +23,6 @@ class PathTracer final : public CameraPathIntegrator {
   }
 
  private:
-  float mis_weight(float pdf_a, float pdf_b) const;
   IntegratorSettings settings_;
 };
 

@@ -9,9 +9,11 @@
 #include <optional>
 #include <vector>
 
+#include "core/math.h"
 #include "core/rgb.h"
 #include "core/rng.h"
 #include "geometry/interaction.h"
+#include "integrators/integrator.h"
 #include "lights/light.h"
 #include "lights/light_sampler.h"
 #include "materials/bsdf.h"
@@ -42,6 +44,30 @@ void for_each_emitter_seen(const std::vector<const Light*>& infinite_lights, con
 // nullptr, the infinite light in that direction.
 float next_event_pdf(const LightSampler& lights, const Light& light, Vec3 prev_p, Vec3 dir,
                      const SurfaceInteraction* hit);
+
+// The MIS heuristic of the camera-path integrators for two densities (power by default).
+inline float mis_weight(MisHeuristic heuristic, float pdf_a, float pdf_b) {
+  return heuristic == MisHeuristic::Power ? power_heuristic(pdf_a, pdf_b)
+                                          : balance_heuristic(pdf_a, pdf_b);
+}
+
+// Emission seen along a sampled ray (at `hit`, or the infinite lights with hit == nullptr),
+// handed to add(Rgb Le, float weight): weight 1 for the camera ray and after a delta bounce (no
+// light sample could have found it), else the MIS weight against next event estimation from
+// prev_p, the ray having been sampled with density prev_pdf.
+template <typename Add>
+void add_emission_seen(const Scene& scene, const Ray& ray, const SurfaceInteraction* hit,
+                       bool full_weight, float prev_pdf, Vec3 prev_p, MisHeuristic heuristic,
+                       Add&& add) {
+  for_each_emitter_seen(scene.infinite_lights(), ray, hit, [&](const Light& light, Rgb Le) {
+    if (full_weight) {
+      add(Le, 1.f);
+      return;
+    }
+    const float light_pdf = next_event_pdf(scene.light_sampler(), light, prev_p, ray.d, hit);
+    add(Le, mis_weight(heuristic, prev_pdf, light_pdf));
+  });
+}
 
 // A light sample for next event estimation from si: the light picked by the power-based light
 // distribution (pmf), the point sampled on it (ls), the BSDF value times |cos| toward it (f) and

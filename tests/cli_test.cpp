@@ -80,3 +80,23 @@ TEST(Cli, HelpExistsForEverySubcommand) {
     EXPECT_EQ(r.exit_code, 0) << sub;
   }
 }
+
+// A reference that shares the runs' random numbers makes the integrators that sample like it
+// look better than they are: `reference` defaults to a seed other than the runs' 0, and
+// `compare` warns when its --reference's metadata names the runs' seed.
+TEST(Cli, ReferenceDoesNotShareTheSeedOfTheRunsItJudges) {
+  const fs::path d = fresh_dir("reference_seed");
+  CliRun r = run("reference cornell --time 0.2 --resolution 16x12 --integrator pt --outfile ref", d);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream f(d / "ref.json");
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_NE(j["seed"].get<uint64_t>(), 0u);
+  const std::string compare =
+      "compare cornell --time 0.2 --resolution 16x12 --integrators pt --reference ref.exr --out ";
+  r = run(compare + "c1", d);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  r = run(compare + "c2 --seed " + std::to_string(j["seed"].get<uint64_t>()), d);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("was rendered with seed"), std::string::npos) << r.err;
+}

@@ -11,6 +11,7 @@
 #include "core/rng.h"
 #include "geometry/texture.h"
 #include "image/image.h"
+#include "integrators/bidir/bidir_guiding.h"
 #include "integrators/bidir/light_vertex.h"
 #include "integrators/bidir/path_weights.h"
 #include "integrators/bidir/techniques.h"
@@ -164,7 +165,8 @@ struct Key {
 std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& path, bool connect,
                                      bool merge, bool power, double light_paths, double radius,
                                      ScratchArena& arena, double raster_density = 1,
-                                     double connections = 1) {
+                                     double connections = 1,
+                                     const BidirGuiding* guiding = nullptr) {
   const Light& light = *path.light;
   const bool finite = !light.is_infinite();
   const double pmf = scene.light_sampler().pmf(&light);
@@ -184,6 +186,11 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
   for (int i = 1; i < k; ++i)
     bsdf[i] = path.surfaces[i - 1].material->bsdf(path.surfaces[i - 1], arena);
   auto delta = [&](int i) { return bsdf[i].is_delta(); };
+  // Guided vertices sample from mixtures (vertex_guides.h): their densities, both ways.
+  auto pdf = [&](int i, Vec3 wo, Vec3 wi, TransportMode mode) {
+    const VertexGuides g = guiding ? guiding->at(x[i], bsdf[i]) : VertexGuides{};
+    return double(direction_pdf(bsdf[i], g, wo, wi, mode));
+  };
   // Solid angle -> area at x[to] (x0 of an infinite light stays a direction).
   auto to_area = [&](int from, int to) {
     return (to == 0 && !finite) ? 1.0 : cos_at(to, dir(to, from)) / d2(from, to);
@@ -197,7 +204,7 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
   light_pdf[1] = finite ? pdf_dir * to_area(0, 1) : pdf_pos * cos_at(1, emit);
   for (int i = 1; i + 1 < k; ++i) {
     const Vec3 wo = i == 1 ? -emit : dir(i, i - 1);
-    const double p = delta(i) ? 1.0 : bsdf[i].pdf(wo, dir(i, i + 1), TransportMode::Importance);
+    const double p = delta(i) ? 1.0 : pdf(i, wo, dir(i, i + 1), TransportMode::Importance);
     light_pdf[i + 1] = p * to_area(i, i + 1);
   }
   // The pixel filter's raster density scales the camera ray's pdf (techniques.h).
@@ -205,7 +212,7 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
       camera_pdf_w(scene.camera(), x[k], dir(k, k - 1)) * raster_density * to_area(k, k - 1);
   for (int i = k - 1; i >= 1; --i) {
     const Vec3 wi = i == 1 ? (finite ? dir(1, 0) : -emit) : dir(i, i - 1);
-    const double p = delta(i) ? 1.0 : bsdf[i].pdf(dir(i, i + 1), wi, TransportMode::Radiance);
+    const double p = delta(i) ? 1.0 : pdf(i, dir(i, i + 1), wi, TransportMode::Radiance);
     camera_pdf[i - 1] = p * to_area(i, i - 1);
   }
   double nee_pdf;
@@ -249,7 +256,40 @@ struct Case {
   float light_paths = 1024;  // N; the scenes have 32 x 32 pixels (corners: 40 x 28)
   int connections = 1;       // per camera vertex
   bool pixel_merges = true;  // false: a pixel of adaptive-vcm that does not merge
+  bool guided = false;       // guided-bpt / guided-vcm: densities of trained guiding fields
 };
+
+// Fields of guided-bpt / guided-vcm trained on synthetic records over the scene's box: directions
+// concentrated around a different axis for radiance and importance (so that forward and
+// reverse densities differ), a spatial threshold low enough that the trees split.
+std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene) {
+  auto g = std::make_unique<BidirGuiding>();
+  GuidingSettings settings;
+  settings.spatial_threshold = 200;
+  settings.bsdf_fraction = 0.3f;
+  g->prepare(scene.bounds(), settings, 1024);
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  const Bounds3 b = scene.bounds();
+  auto point = [&] {
+    const Vec3 d = b.diagonal();
+    return b.lo + Vec3(u(gen) * d.x, u(gen) * d.y, u(gen) * d.z);
+  };
+  auto around = [&](Vec3 axis) { return normalize(axis * 1.5f + Vec3(u(gen), u(gen), u(gen)) - Vec3(0.5f, 0.5f, 0.5f)); };
+  for (int pass = 0; pass < 3; ++pass) {
+    g->begin_iteration(uint32_t((1u << pass) - 1));
+    std::vector<LightVertex> photons;
+    for (int i = 0; i < 4000; ++i) {
+      photons.push_back(pack_light_vertex(
+          {point(), around(Vec3(0, 1, 0)), 0, 1, Rgb(0.1f + u(gen)), MisSums{}}));
+      g->record_camera_vertex(uint64_t(i), 1, point(), around(Vec3(0, 0, -1)),
+                              Rgb(0.1f + u(gen)));
+    }
+    g->end_iteration(photons);
+  }
+  g->begin_iteration(7);  // ends the last pass: its distributions are sampled from
+  return g;
+}
 
 // With filter_densities, each path is weighted for a pixel whose filter has a random raster
 // density (0.01 to 4) at the path's raster point, as non-box pixel filters give.
@@ -257,9 +297,12 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
                               bool filter_densities = false) {
   Pcg32 rng(7, 11);
   ScratchArena arena;
+  const std::unique_ptr<BidirGuiding> guiding = c.guided ? trained_guiding(scene) : nullptr;
+  int guided_vertices = 0;
   const float light_paths = c.light_paths, radius = 0.02f;
   const bool connect = c.algorithm != BidirAlgorithm::Bpm,
-             merge = c.algorithm != BidirAlgorithm::Bpt && c.pixel_merges;
+             merge = c.algorithm != BidirAlgorithm::Bpt &&
+                     c.algorithm != BidirAlgorithm::GuidedBpt && c.pixel_merges;
   int checked = 0, attempts = 0, with_delta = 0;
   double worst_sum = 0, worst_oracle = 0;
   ExplicitPath path;
@@ -268,11 +311,12 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
     arena.reset();
     if (!random_path(scene, rng, arena, &path)) continue;
     const float density = filter_densities ? 0.01f + 3.99f * rng.next_float() : 1.f;
-    const auto weights = production_weights(scene, c.algorithm, c.heuristic, light_paths, radius,
-                                            path, arena, density, c.connections, c.pixel_merges);
+    const auto weights =
+        production_weights(scene, c.algorithm, c.heuristic, light_paths, radius, path, arena,
+                           density, c.connections, c.pixel_merges, guiding.get());
     const auto oracle =
         oracle_weights(scene, path, connect, merge, c.heuristic == MisHeuristic::Power, light_paths,
-                       radius, arena, density, c.connections);
+                       radius, arena, density, c.connections, guiding.get());
     if (oracle.empty() || !std::isfinite(oracle.begin()->second))
       continue;  // no technique can make it
     double sum = 0;
@@ -293,11 +337,19 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
         ++with_delta;
         break;
       }
+    if (guiding) {
+      for (const SurfaceInteraction& si : path.surfaces) {
+        const VertexGuides g = guiding->at(si.p, si.material->bsdf(si, arena));
+        guided_vertices += g.radiance && g.importance;
+      }
+    }
     ASSERT_NEAR(sum, 1.0, 1e-4) << c.scene << " path " << checked << " with " << weights.size()
                                 << " techniques";
     ++checked;
   }
   EXPECT_EQ(checked, paths) << c.scene << ": could not build enough paths";
+  // The guided cases must exercise guided densities: on average a guided vertex per two paths.
+  if (guiding) EXPECT_GT(2 * guided_vertices, paths) << c.scene;
   std::printf(
       "[ partition ] %-14s %d paths (%d through delta vertices), max |sum - 1| = %.2e, max |w - "
       "oracle| = %.2e\n",
@@ -339,13 +391,21 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Balance, 2240, 2, false},
                       Case{"mixed-lights", BidirAlgorithm::Vcm, MisHeuristic::Power, 512, 8},
                       Case{"cornell-glass", BidirAlgorithm::Bpt, MisHeuristic::Balance, 2048, 2,
-                           false}),
+                           false},
+                      // guided-vcm / guided-bpt: guided densities forward and reverse.
+                      Case{"cornell", BidirAlgorithm::GuidedVcm, MisHeuristic::Balance, 1024, 1,
+                           true, true},
+                      Case{"mixed-lights", BidirAlgorithm::GuidedVcm, MisHeuristic::Power, 1024,
+                           1, true, true},
+                      Case{"corners", BidirAlgorithm::GuidedBpt, MisHeuristic::Balance, 700, 2,
+                           true, true}),
     [](const auto& info) {
       std::string n =
           std::string(info.param.scene) + "_" + std::to_string(int(info.param.algorithm)) + "_" +
           (info.param.heuristic == MisHeuristic::Power ? "power" : "balance") + "_N" +
           std::to_string(int(info.param.light_paths)) + "_c" +
-          std::to_string(info.param.connections) + (info.param.pixel_merges ? "" : "_nomerge");
+          std::to_string(info.param.connections) + (info.param.pixel_merges ? "" : "_nomerge") +
+          (info.param.guided ? "_guided" : "");
       for (char& ch : n)
         if (ch == '-') ch = '_';
       return n;

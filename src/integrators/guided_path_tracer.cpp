@@ -112,23 +112,6 @@ Mixture mixture_at(const GuidingField& field, bool filter, Vec3 p, const Bsdf& b
   return mix;
 }
 
-// Roulette on the larger of the throughput and the one BSDF sampling alone would have had
-// (rr_beta): a guided direction toward bright light has a small weight (its density is high) and
-// must not be ended for it, nor a path whose weight grew. Any survival probability that depends
-// only on the path so far keeps the estimate unbiased. Returns false when the path ends; else
-// both throughputs are divided by the survival probability.
-bool survives_guided_roulette(Rgb& beta, Rgb& rr_beta, float eta_scale, int depth, Pcg32& rng) {
-  const Rgb larger(std::max(beta.r, rr_beta.r), std::max(beta.g, rr_beta.g),
-                   std::max(beta.b, rr_beta.b));
-  const float q = russian_roulette_end(larger, eta_scale, depth);
-  if (q > 0) {
-    if (rng.next_float() < q) return false;
-    beta = beta / (1 - q);
-    rr_beta = rr_beta / (1 - q);
-  }
-  return true;
-}
-
 // A guided vertex whose incident radiance along wi is recorded once the path is done.
 struct GuidedVertex {
   GuidingRecord record;  // radiance and product filled in at the end

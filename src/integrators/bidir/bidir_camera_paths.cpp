@@ -60,6 +60,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   const uint64_t light_path = it.light_path_of.light_path(pixel);
 
   Rgb beta(1.f);
+  Rgb rr_beta(1.f);  // the throughput BSDF sampling alone would have (guided roulette)
   Vec3 prev_p = ray.o;
   int depth = 0;              // surface vertices so far
   bool specular_path = true;  // every bounce so far was specular
@@ -107,26 +108,53 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
 
     const bool delta = bsdf.is_delta();
     ++acc.work.camera_vertices;
-    if (!delta)
-      vertex_techniques(scene, it, {si, bsdf, beta, mis, depth}, light_path, rng, arena, acc);
+    const VertexGuides guides = tech_.guided ? guiding_.at(si.p, bsdf) : VertexGuides{};
+    if (!delta) {
+      vertex_techniques(scene, it, {si, bsdf, beta, mis, depth, guides}, light_path, rng, arena,
+                        acc);
+      if (tech_.guided && guiding_.records_pixel(pixel))
+        guiding_.record_camera_vertex(pixel, depth, si.p, si.wo, beta);
+    }
 
-    const float uc = rng.next_float();
-    const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Radiance);
-    if (!bs) break;
-    // PPM / lt: the non-delta part of this vertex was estimated by merging (or belongs to light
-    // tracing); only its delta lobes carry the camera path on.
-    if (tech_.camera_stops && !delta && !bs->is_specular()) break;
-    const float pdf_fwd =
-        bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Radiance) : bs->pdf;
-    scatter_update(rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Radiance, bs->is_specular(),
-                   pdf_fwd);
-    beta *= bs->f * (bsdf.abs_cos(bs->wi) / bs->pdf);
-    specular_path = specular_path && bs->is_specular();
-    if (bs->is_transmission()) eta_scale *= sqr(bs->eta);
+    Vec3 wi;
+    if (guides.radiance) {
+      // guided: the mixture of the BSDF and the learned radiance (vertex_guides.h)
+      const float u_technique = rng.next_float(), uc = rng.next_float();
+      const auto gs = sample_guided(bsdf, guides, si.wo, TransportMode::Radiance, u_technique, uc,
+                                    rng.next_2d());
+      if (!gs) break;
+      wi = gs->wi;
+      scatter_update(rules, mis, si, bsdf, si.wo, wi, TransportMode::Radiance, false, gs->pdf,
+                     guides);
+      beta *= gs->weight;
+      rr_beta *= gs->bsdf_weight;
+      specular_path = false;
+      eta_scale *= sqr(gs->eta);
+    } else {
+      const float uc = rng.next_float();
+      const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Radiance);
+      if (!bs) break;
+      // PPM / lt: the non-delta part of this vertex was estimated by merging (or belongs to
+      // light tracing); only its delta lobes carry the camera path on.
+      if (tech_.camera_stops && !delta && !bs->is_specular()) break;
+      wi = bs->wi;
+      const float pdf_fwd =
+          bs->pdf_is_proportional ? direction_pdf(bsdf, guides, si.wo, wi, TransportMode::Radiance)
+                                  : bs->pdf;
+      scatter_update(rules, mis, si, bsdf, si.wo, wi, TransportMode::Radiance, bs->is_specular(),
+                     pdf_fwd, guides);
+      const Rgb weight = bs->f * (bsdf.abs_cos(wi) / bs->pdf);
+      beta *= weight;
+      rr_beta *= weight;
+      specular_path = specular_path && bs->is_specular();
+      if (bs->is_transmission()) eta_scale *= sqr(bs->eta);
+    }
     if (beta.is_black()) break;
     prev_p = si.p;
-    ray = si.spawn_ray(bs->wi);
-    if (!survives_russian_roulette(beta, eta_scale, depth, rng)) break;
+    ray = si.spawn_ray(wi);
+    if (tech_.guided ? !survives_guided_roulette(beta, rr_beta, eta_scale, depth, rng)
+                     : !survives_russian_roulette(beta, eta_scale, depth, rng))
+      break;
   }
 }
 
@@ -137,56 +165,54 @@ void BidirIntegrator::vertex_techniques(const Scene& scene, const Iteration& it,
   const bool timed = acc.plan && settings_.bidir.measured_costs;
   ++acc.work.nondelta_camera_vertices;
   if (tech_.connect) {
-    next_event(scene, rules, v.si, v.bsdf, v.beta, v.mis, v.depth, rng, acc);
+    next_event(scene, rules, v, rng, acc);
     const auto t0 = timed ? std::chrono::steady_clock::now() : Clock::time_point{};
-    connect_to_light_paths(scene, it, rules, v.si, v.bsdf, v.beta, v.mis, v.depth, light_path, rng,
-                           arena, acc);
+    connect_to_light_paths(scene, it, rules, v, light_path, rng, arena, acc);
     if (timed) acc.work.connect_seconds += seconds_since(t0);
   }
   if (tech_.merge && it.plan.merges(acc.pixel)) {
     const auto t0 = timed ? std::chrono::steady_clock::now() : Clock::time_point{};
-    merge(scene, it, rules, v.si, v.bsdf, v.beta, v.mis, v.depth, acc);
+    merge(scene, it, rules, v, acc);
     if (timed) acc.work.merge_seconds += seconds_since(t0);
   }
 }
 
-void BidirIntegrator::next_event(const Scene& scene, const MisRules& rules,
-                                 const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
-                                 const MisSums& mis, int depth, Pcg32& rng,
-                                 PixelAccumulator& acc) const {
+void BidirIntegrator::next_event(const Scene& scene, const MisRules& rules, const CameraVertex& v,
+                                 Pcg32& rng, PixelAccumulator& acc) const {
   const float u_light = rng.next_float();
   const Vec2 u = rng.next_2d();
-  const auto d = sample_direct_light(scene, si, bsdf, u_light, u);
+  const auto d = sample_direct_light(scene, v.si, v.bsdf, u_light, u);
   if (!d) return;
-  const TechniqueTerms terms = terms_next_event(rules, *d->light, d->pmf, d->ls, si, bsdf, mis);
+  const TechniqueTerms terms =
+      terms_next_event(rules, *d->light, d->pmf, d->ls, v.si, v.bsdf, v.mis, v.guides);
   const float w = terms.weight(rules.counts());
-  const Rgb value = beta * d->f * d->ls.radiance * (w / (d->pmf * d->ls.pdf_w));
+  const Rgb value = v.beta * d->f * d->ls.radiance * (w / (d->pmf * d->ls.pdf_w));
   if (value.is_black()) return;
   if (scene.occluded(d->shadow)) return;
-  acc.add(false, 1, depth + 1, value, &terms);
+  acc.add(false, 1, v.depth + 1, value, &terms);
 }
 
 void BidirIntegrator::connect_to_light_paths(const Scene& scene, const Iteration& it,
-                                             const MisRules& rules, const SurfaceInteraction& si,
-                                             const Bsdf& bsdf, Rgb beta, const MisSums& mis,
-                                             int depth, uint64_t light_path, Pcg32& rng,
-                                             ScratchArena& arena, PixelAccumulator& acc) const {
+                                             const MisRules& rules, const CameraVertex& v,
+                                             uint64_t light_path, Pcg32& rng, ScratchArena& arena,
+                                             PixelAccumulator& acc) const {
   const uint64_t n = it.plan.light_paths;
   const int c = it.plan.connections;
   if (n == 0 || c == 0) return;
-  const Rgb scaled = beta / float(c);
+  const Rgb scaled = v.beta / float(c);
   for (int j = 0; j < c; ++j) {
     const uint64_t path =
         j == 0 ? light_path : std::min<uint64_t>(uint64_t(rng.next_float() * double(n)), n - 1);
-    connect_to_light_path(scene, rules, si, bsdf, scaled, mis, depth, path, arena, acc);
+    connect_to_light_path(scene, rules, v, scaled, path, arena, acc);
   }
 }
 
 void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& rules,
-                                            const SurfaceInteraction& si, const Bsdf& bsdf,
-                                            Rgb beta, const MisSums& mis, int depth,
-                                            uint64_t light_path, ScratchArena& arena,
-                                            PixelAccumulator& acc) const {
+                                            const CameraVertex& cv, Rgb beta, uint64_t light_path,
+                                            ScratchArena& arena, PixelAccumulator& acc) const {
+  const SurfaceInteraction& si = cv.si;
+  const Bsdf& bsdf = cv.bsdf;
+  const int depth = cv.depth;
   for (uint32_t i = path_begin_[light_path]; i < path_begin_[light_path + 1]; ++i) {
     const LightVertex& stored = vertices_[i];
     // Stored in increasing depth: once too long, all the rest are too.
@@ -205,8 +231,10 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
         light_bsdf.f(v.wo, -dir, TransportMode::Importance) * light_bsdf.abs_cos(dir);
     if (f_light.is_black()) continue;
     ++acc.work.connections;
-    const TechniqueTerms terms =
-        terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf, mis);
+    const VertexGuides light_guides =
+        tech_.guided ? guiding_.at(light_si.p, light_bsdf) : VertexGuides{};
+    const TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf,
+                                                  cv.mis, light_guides, cv.guides);
     const float w = terms.weight(rules.counts());
     const Rgb value = beta * v.throughput * f_camera * f_light * (w / dist2);
     if (value.is_black()) continue;
@@ -216,8 +244,10 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
 }
 
 void BidirIntegrator::merge(const Scene& scene, const Iteration& it, const MisRules& rules,
-                            const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
-                            const MisSums& mis, int depth, PixelAccumulator& acc) const {
+                            const CameraVertex& cv, PixelAccumulator& acc) const {
+  const SurfaceInteraction& si = cv.si;
+  const Bsdf& bsdf = cv.bsdf;
+  const int depth = cv.depth;
   ++acc.work.merge_queries;
   const int max_depth = settings_.max_depth;
   const Scene::PrimitiveRange own_shape = scene.shape_primitives(si);
@@ -240,10 +270,10 @@ void BidirIntegrator::merge(const Scene& scene, const Iteration& it, const MisRu
     if (!own_shape.contains(v.primitive) &&
         !photon_visible(scene, si, v.primitive, q, v.wo, it.radius))
       return;
-    const TechniqueTerms terms = terms_merge(rules, v.wo, v.mis, si, bsdf, mis);
+    const TechniqueTerms terms = terms_merge(rules, v.wo, v.mis, si, bsdf, cv.mis, cv.guides);
     const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
     acc.add(true, light_depth + 1, depth + 1,
-            beta * f * v.throughput * (w * it.merge_normalization), &terms);
+            cv.beta * f * v.throughput * (w * it.merge_normalization), &terms);
   });
 }
 

@@ -14,6 +14,7 @@
 #include "film/pixel_filter.h"
 #include "image/image.h"
 #include "integrators/bidir/adaptive_plan.h"
+#include "integrators/bidir/bidir_guiding.h"
 #include "integrators/bidir/bidir_integrator.h"
 #include "integrators/bidir/hash_grid.h"
 #include "integrators/bidir/light_path_assignment.h"
@@ -43,6 +44,7 @@ struct Techniques {
   bool camera_stops = false;     // camera subpaths end at their first non-delta vertex
   bool unweighted = false;       // single-technique estimators (lt, ppm): all weights 1
   bool adaptive = false;         // configuration chosen per iteration (adaptive_plan.h)
+  bool guided = false;           // subpaths guided by learned fields (bidir_guiding.h)
 };
 
 struct Splat {
@@ -158,8 +160,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
   // t = 1: the light vertex seen through a lens point; splat recorded in the chunk.
   void connect_to_camera(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
-                         const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth, Pcg32& rng,
-                         LightChunk& chunk) const;
+                         const Bsdf& bsdf, const VertexGuides& guides, Rgb beta,
+                         const MisSums& mis, int depth, Pcg32& rng, LightChunk& chunk) const;
 
   // ---- camera subpaths ----------------------------------------------------------------------
   // The seam's per-pixel call: the camera subpath of this iteration (current_).
@@ -179,27 +181,26 @@ class BidirIntegrator final : public CameraPathIntegrator {
     Rgb beta;
     const MisSums& mis;
     int depth;
+    const VertexGuides& guides;
   };
   void vertex_techniques(const Scene& scene, const Iteration& it, const CameraVertex& v,
                          uint64_t light_path, Pcg32& rng, ScratchArena& arena,
                          PixelAccumulator& acc) const;
 
-  void next_event(const Scene& scene, const MisRules& rules, const SurfaceInteraction& si,
-                  const Bsdf& bsdf, Rgb beta, const MisSums& mis, int depth, Pcg32& rng,
+  void next_event(const Scene& scene, const MisRules& rules, const CameraVertex& v, Pcg32& rng,
                   PixelAccumulator& acc) const;
 
   // Connections to the vertices of `connections` light paths: the pixel's own, then paths drawn
   // uniformly (each light path is an independent sample, so any choice is unbiased); each
   // connection is one of c samples, hence the 1 / c.
   void connect_to_light_paths(const Scene& scene, const Iteration& it, const MisRules& rules,
-                              const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
-                              const MisSums& mis, int depth, uint64_t light_path, Pcg32& rng,
+                              const CameraVertex& v, uint64_t light_path, Pcg32& rng,
                               ScratchArena& arena, PixelAccumulator& acc) const;
 
-  void connect_to_light_path(const Scene& scene, const MisRules& rules,
-                             const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
-                             const MisSums& mis, int depth, uint64_t light_path,
-                             ScratchArena& arena, PixelAccumulator& acc) const;
+  // beta: the camera vertex's throughput over the connections per vertex.
+  void connect_to_light_path(const Scene& scene, const MisRules& rules, const CameraVertex& v,
+                             Rgb beta, uint64_t light_path, ScratchArena& arena,
+                             PixelAccumulator& acc) const;
 
   // Merging accepts a photon only if light could have reached the query's surface through it
   // (no leaks through zero-thickness walls):
@@ -210,9 +211,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
   //    ray from the query to a point just off the photon on the side it arrived from. Photons
   //    on the query's own shape are trusted, so the ray is traced only near shape boundaries.
   // Each test only removes photons; at distance 0 (the partition test's merges) all pass.
-  void merge(const Scene& scene, const Iteration& it, const MisRules& rules,
-             const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta, const MisSums& mis,
-             int depth, PixelAccumulator& acc) const;
+  void merge(const Scene& scene, const Iteration& it, const MisRules& rules, const CameraVertex& v,
+             PixelAccumulator& acc) const;
 
   // Whether light arriving along wo at the query could be the photon's (a photon on another
   // shape than the query). Each point must lie on the lit side (the side of wo) of the other's
@@ -254,6 +254,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
   double camera_seconds_total_ = 0;  // of seconds_total_, tracing camera paths
   ProbeWork work_total_;             // operations counted over all iterations (counts only)
   std::vector<std::string> technique_files_;
+
+  // guided-bpt / guided-vcm: the learned fields.
+  BidirGuiding guiding_;
 
   // adaptive-vcm: the plan, and the work of the current probe iteration.
   mutable AdaptivePlan plan_;

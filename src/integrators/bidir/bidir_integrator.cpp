@@ -34,6 +34,12 @@ Techniques techniques_of(BidirAlgorithm a) {
     case BidirAlgorithm::AdaptiveVcm:
       t.light_to_camera = t.connect = t.merge = t.adaptive = true;
       break;
+    case BidirAlgorithm::GuidedBpt:
+      t.light_to_camera = t.connect = t.guided = true;
+      break;
+    case BidirAlgorithm::GuidedVcm:
+      t.light_to_camera = t.connect = t.merge = t.guided = true;
+      break;
   }
   return t;
 }
@@ -52,6 +58,10 @@ const char* name_of(BidirAlgorithm a) {
       return "vcm";
     case BidirAlgorithm::AdaptiveVcm:
       return "adaptive-vcm";
+    case BidirAlgorithm::GuidedBpt:
+      return "guided-bpt";
+    case BidirAlgorithm::GuidedVcm:
+      return "guided-vcm";
   }
   return "?";
 }
@@ -66,6 +76,7 @@ void BidirIntegrator::prepare(const Scene& scene, Film& film) {
                                             : kDefaultRadiusFactor * std::max(scene_radius, 1e-3f);
   light_paths_ = settings_.bidir.light_paths > 0 ? settings_.bidir.light_paths : film.pixel_count();
   if (!settings_.bidir.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
+  if (tech_.guided) guiding_.prepare(scene.bounds(), settings_.guiding, film.pixel_count());
   if (tech_.adaptive)
     plan_ = AdaptivePlan(film.width(), film.height(), settings_.bidir.measured_costs,
                          settings_.bidir.probe_every_iteration);
@@ -97,6 +108,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   it.merge_normalization = n ? 1.f / (kPi * it.radius * it.radius * float(n)) : 0.f;
   it.light_path_of =
       LightPathAssignment(film.pixel_count(), std::max<uint64_t>(n, 1), iteration, settings_.seed);
+  if (tech_.guided) guiding_.begin_iteration(iteration);
   probe_ = {};
   probe_.light_paths = double(n);
   if (it.plan.probe) plan_.begin_probe(it.radius);
@@ -121,6 +133,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   const auto camera_start = std::chrono::steady_clock::now();
   trace_camera_paths(scene, iteration, film);
   camera_seconds_total_ += seconds_since(camera_start);
+  if (tech_.guided) guiding_.end_iteration(vertices_);
   probe_.light_vertices = double(vertices_.size());
   add_counts(work_total_, probe_);
   if (it.plan.probe) {
@@ -143,6 +156,7 @@ void BidirIntegrator::finish(const Scene&, Film& film) {
 
 void BidirIntegrator::report(nlohmann::json& stats) const {
   if (tech_.adaptive) plan_.report(stats);
+  if (tech_.guided) guiding_.report(stats);
   nlohmann::json b;
   b["algorithm"] = name();
   b["mis"] = heuristic_ == MisHeuristic::Power ? "power" : "balance";

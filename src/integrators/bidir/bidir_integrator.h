@@ -13,6 +13,9 @@
 //   vcm  bpt + bpm with MIS over all (merge acceptance p_acc = pi r^2 per light path).
 //   adaptive-vcm  vcm whose light-path count, connections per camera vertex and per-pixel
 //        merging are chosen while rendering by efficiency-aware MIS (adaptive_plan.h).
+//   guided-bpt, guided-vcm  bpt and vcm whose camera subpaths are guided by the incident
+//        radiance and whose light subpaths by the incident importance, both learned while
+//        rendering, with the MIS densities of the guided mixtures (bidir_guiding.h).
 //
 // Per iteration: N light subpaths (settings.bidir.light_paths, 0 = one per pixel) are traced in
 // chunks whose size depends on N only (at most 1024 paths; at least 64 chunks when N allows),
@@ -35,7 +38,7 @@
 
 namespace caustica {
 
-enum class BidirAlgorithm { LightTracing, Bpt, Ppm, Bpm, Vcm, AdaptiveVcm };
+enum class BidirAlgorithm { LightTracing, Bpt, Ppm, Bpm, Vcm, AdaptiveVcm, GuidedBpt, GuidedVcm };
 
 std::unique_ptr<Integrator> make_bidir_integrator(BidirAlgorithm algorithm,
                                                   const IntegratorSettings& settings);

@@ -136,6 +136,7 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
   if (!le || !(le->pdf_pos > 0) || !(le->pdf_dir > 0) || le->radiance.is_black()) return;
   const float emission_pdf = pmf * le->pdf_pos * le->pdf_dir;
   Rgb beta = le->radiance * (le->cos_at_light / emission_pdf);
+  Rgb rr_beta = beta;  // the throughput BSDF sampling alone would have (guided roulette)
   const float beta_start = beta.max_component();
   const int max_depth = settings_.max_depth;
 
@@ -162,41 +163,64 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
     segment = 0;
     if (depth > max_depth) break;
 
+    const VertexGuides guides = tech_.guided ? guiding_.at(si.p, bsdf) : VertexGuides{};
     if (!bsdf.is_delta()) {
       if (stores_vertices()) {
         chunk.vertices.push_back(
             pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}));
       }
       if (tech_.light_to_camera)
-        connect_to_camera(scene, it, si, bsdf, beta, mis, depth, rng, chunk);
+        connect_to_camera(scene, it, si, bsdf, guides, beta, mis, depth, rng, chunk);
     }
     if (depth + 1 > max_depth) break;
 
-    const float uc = rng.next_float();
-    const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Importance);
-    if (!bs) break;
-    const float pdf_fwd =
-        bs->pdf_is_proportional ? bsdf.pdf(si.wo, bs->wi, TransportMode::Importance) : bs->pdf;
-    scatter_update(it.rules, mis, si, bsdf, si.wo, bs->wi, TransportMode::Importance,
-                   bs->is_specular(), pdf_fwd);
-    beta *= bs->f * (bsdf.abs_cos(bs->wi) / bs->pdf);
+    Vec3 wi;
+    if (guides.importance) {
+      // guided: the mixture of the BSDF and the learned importance (vertex_guides.h)
+      const float u_technique = rng.next_float(), uc = rng.next_float();
+      const auto gs = sample_guided(bsdf, guides, si.wo, TransportMode::Importance, u_technique,
+                                    uc, rng.next_2d());
+      if (!gs) break;
+      wi = gs->wi;
+      scatter_update(it.rules, mis, si, bsdf, si.wo, wi, TransportMode::Importance, false, gs->pdf,
+                     guides);
+      beta *= gs->weight;
+      rr_beta *= gs->bsdf_weight;
+    } else {
+      const float uc = rng.next_float();
+      const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Importance);
+      if (!bs) break;
+      wi = bs->wi;
+      const float pdf_fwd =
+          bs->pdf_is_proportional ? direction_pdf(bsdf, guides, si.wo, wi, TransportMode::Importance)
+                                  : bs->pdf;
+      scatter_update(it.rules, mis, si, bsdf, si.wo, wi, TransportMode::Importance,
+                     bs->is_specular(), pdf_fwd, guides);
+      const Rgb weight = bs->f * (bsdf.abs_cos(wi) / bs->pdf);
+      beta *= weight;
+      rr_beta *= weight;
+    }
     if (beta.is_black()) break;
-    ray = si.spawn_ray(bs->wi);
+    ray = si.spawn_ray(wi);
     // Russian roulette on the throughput relative to the emitted one (importance carries no
-    // radiance scaling at refractions, so no eta correction).
-    const float rr = beta.max_component() / beta_start;
+    // radiance scaling at refractions, so no eta correction); guided, on the larger of it and
+    // BSDF sampling's (path_vertex.h, survives_guided_roulette).
+    const float rr = (tech_.guided ? std::max(beta.max_component(), rr_beta.max_component())
+                                   : beta.max_component()) /
+                     beta_start;
     if (rr < 1 && depth > 1) {
       const float q = std::max(0.f, 1 - rr);
       if (rng.next_float() < q) break;
       beta = beta / (1 - q);
+      rr_beta = rr_beta / (1 - q);
     }
   }
 }
 
 void BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
-                                        const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
-                                        const MisSums& mis, int depth, Pcg32& rng,
-                                        LightChunk& chunk) const {
+                                        const SurfaceInteraction& si, const Bsdf& bsdf,
+                                        const VertexGuides& guides, Rgb beta, const MisSums& mis,
+                                        int depth, Pcg32& rng, LightChunk& chunk) const {
   const Camera& camera = scene.camera();
   const auto cs = camera.sample_wi(si.p, rng.next_2d());
   if (!cs || !(cs->importance > 0)) return;
@@ -213,7 +237,7 @@ void BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
         const uint32_t pixel = uint32_t(y * camera.width() + x);
         const MisRules& rules = it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
         const TechniqueTerms terms =
-            terms_light_to_camera(rules, camera, si, bsdf, si.wo, mis, cs->p_lens, fs.pdf);
+            terms_light_to_camera(rules, camera, si, bsdf, si.wo, mis, cs->p_lens, fs.pdf, guides);
         const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
         const Rgb value = beta * f * (scale * w) * (fs.weight * fs.pdf);
         if (value.is_black()) return;

@@ -13,9 +13,11 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
                                                 MisHeuristic heuristic, float light_paths,
                                                 float radius, const ExplicitPath& path,
                                                 ScratchArena& arena, float raster_density,
-                                                int connections, bool pixel_merges) {
+                                                int connections, bool pixel_merges,
+                                                const BidirGuiding* guiding) {
   const bool connect = algorithm != BidirAlgorithm::Bpm;
-  const bool merge = algorithm != BidirAlgorithm::Bpt && pixel_merges;
+  const bool merge = algorithm != BidirAlgorithm::Bpt && algorithm != BidirAlgorithm::GuidedBpt &&
+                     pixel_merges;
   MisCounts counts;
   counts.emitter = connect ? 1.f : 0.f;
   counts.light_trace = connect ? light_paths : 0.f;
@@ -44,6 +46,8 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
     bsdf[i] = path.surfaces[i - 1].material->bsdf(path.surfaces[i - 1], arena);
   }
   auto delta = [&](int i) { return bsdf[i].is_delta(); };
+  std::vector<VertexGuides> guides(k);
+  for (int i = 1; guiding && i < k; ++i) guides[i] = guiding->at(x[i], bsdf[i]);
 
   // Light subpath replay: sums at x1..x(k-1), stored and reloaded as the renderer does.
   LightLeSample le;
@@ -61,9 +65,10 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
       const bool specular = delta(i - 1);
       const float pdf_fwd =
           specular ? 1.f
-                   : bsdf[i - 1].pdf(light_si[i - 1].wo, dir(i - 1, i), TransportMode::Importance);
+                   : direction_pdf(bsdf[i - 1], guides[i - 1], light_si[i - 1].wo, dir(i - 1, i),
+                                   TransportMode::Importance);
       scatter_update(rules, m, light_si[i - 1], bsdf[i - 1], light_si[i - 1].wo, dir(i - 1, i),
-                     TransportMode::Importance, specular, pdf_fwd);
+                     TransportMode::Importance, specular, pdf_fwd, guides[i - 1]);
       rules.hit(m, distance_squared(x[i - 1], x[i]), geometric_cos(light_si[i], dir(i, i - 1)));
       light_mis[i] = m;
     }
@@ -85,9 +90,10 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
     const bool specular = delta(i + 1);
     const float pdf_fwd =
         specular ? 1.f
-                 : bsdf[i + 1].pdf(camera_si[i + 1].wo, dir(i + 1, i), TransportMode::Radiance);
+                 : direction_pdf(bsdf[i + 1], guides[i + 1], camera_si[i + 1].wo, dir(i + 1, i),
+                                 TransportMode::Radiance);
     scatter_update(rules, m, camera_si[i + 1], bsdf[i + 1], camera_si[i + 1].wo, dir(i + 1, i),
-                   TransportMode::Radiance, specular, pdf_fwd);
+                   TransportMode::Radiance, specular, pdf_fwd, guides[i + 1]);
     rules.hit(m, distance_squared(x[i + 1], x[i]), geometric_cos(camera_si[i], dir(i, i + 1)));
     camera_mis[i] = m;
   }
@@ -99,9 +105,11 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
     MisSums m = camera_mis[1];
     const bool specular = delta(1);
     const float pdf_fwd =
-        specular ? 1.f : bsdf[1].pdf(camera_si[1].wo, to_light, TransportMode::Radiance);
+        specular ? 1.f
+                 : direction_pdf(bsdf[1], guides[1], camera_si[1].wo, to_light,
+                                 TransportMode::Radiance);
     scatter_update(rules, m, camera_si[1], bsdf[1], camera_si[1].wo, to_light,
-                   TransportMode::Radiance, specular, pdf_fwd);
+                   TransportMode::Radiance, specular, pdf_fwd, guides[1]);
     float w;
     if (finite) {
       SurfaceInteraction emitter;
@@ -126,7 +134,8 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
     light.pdf_le(x[0], le.n, -ls.wi, &ls.pdf_emit_pos, &ls.pdf_emit_dir);
     ls.cos_at_light = light.type() == LightType::Area ? abs_dot(path.light_normal, ls.wi) : 1.f;
     out.push_back({false, 1, k,
-                   terms_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1])
+                   terms_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1],
+                                    guides[1])
                        .weight(rules.counts())});
   }
   // 2 <= s <= k - 1: connections of x(s-1) and x(s).
@@ -134,14 +143,16 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
     if (delta(s - 1) || delta(s)) continue;
     out.push_back({false, s, k + 1 - s,
                    terms_connection(rules, light_si[s - 1], bsdf[s - 1], light_si[s - 1].wo,
-                                    stored(s - 1), camera_si[s], bsdf[s], camera_mis[s])
+                                    stored(s - 1), camera_si[s], bsdf[s], camera_mis[s],
+                                    guides[s - 1], guides[s])
                        .weight(rules.counts())});
   }
   // t = 1: x(k-1) connected to the lens.
   if (connect && k >= 2 && !delta(k - 1)) {
     out.push_back({false, k, 1,
                    terms_light_to_camera(rules, scene.camera(), light_si[k - 1], bsdf[k - 1],
-                                         light_si[k - 1].wo, stored(k - 1), x[k], raster_density)
+                                         light_si[k - 1].wo, stored(k - 1), x[k], raster_density,
+                                         guides[k - 1])
                        .weight(rules.counts())});
   }
   // Merges at every non-delta interior vertex.
@@ -149,7 +160,8 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
     if (delta(j)) continue;
     out.push_back(
         {true, j + 1, k + 1 - j,
-         terms_merge(rules, light_si[j].wo, stored(j), camera_si[j], bsdf[j], camera_mis[j])
+         terms_merge(rules, light_si[j].wo, stored(j), camera_si[j], bsdf[j], camera_mis[j],
+                     guides[j])
              .weight(rules.counts())});
   }
   return out;

@@ -8,6 +8,7 @@
 
 #include "core/arena.h"
 #include "geometry/interaction.h"
+#include "integrators/bidir/bidir_guiding.h"
 #include "integrators/bidir/bidir_integrator.h"
 
 namespace caustica {
@@ -39,10 +40,13 @@ struct TechniqueWeight {
 // pixel it is estimated for (camera_pdf_w; 1 for the box of radius 1/2).
 // connections: light subpaths each camera vertex connects to (their count in the weights);
 // pixel_merges: false for a pixel of adaptive-vcm that does not merge.
+// guiding: the learned fields of guided-bpt / guided-vcm (their vertices' densities are the
+// guided mixtures'); nullptr: unguided.
 std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
                                                 MisHeuristic heuristic, float light_paths,
                                                 float radius, const ExplicitPath& path,
                                                 ScratchArena& arena, float raster_density = 1.f,
-                                                int connections = 1, bool pixel_merges = true);
+                                                int connections = 1, bool pixel_merges = true,
+                                                const BidirGuiding* guiding = nullptr);
 
 }  // namespace caustica::bidir

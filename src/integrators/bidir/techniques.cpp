@@ -33,8 +33,8 @@ MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf
 
 void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteraction& si,
                     const Bsdf& bsdf, Vec3 wo, Vec3 wi, TransportMode mode, bool specular,
-                    float pdf_fwd) {
-  const float pdf_rev = specular ? pdf_fwd : bsdf.pdf(wi, wo, !mode);
+                    float pdf_fwd, const VertexGuides& guides) {
+  const float pdf_rev = specular ? pdf_fwd : direction_pdf(bsdf, guides, wi, wo, !mode);
   rules.scatter(mis, geometric_cos(si, wi), pdf_fwd, pdf_rev, specular);
 }
 
@@ -54,9 +54,11 @@ TechniqueTerms terms_emitter_hit(const MisRules& rules, const Light& light, floa
 
 TechniqueTerms terms_next_event(const MisRules& rules, const Light& light, float pmf,
                                 const LightLiSample& ls, const SurfaceInteraction& si,
-                                const Bsdf& bsdf, const MisSums& camera) {
-  const float bsdf_fwd = light.is_delta() ? 0.f : bsdf.pdf(si.wo, ls.wi, TransportMode::Radiance);
-  const float bsdf_rev = bsdf.pdf(ls.wi, si.wo, TransportMode::Importance);
+                                const Bsdf& bsdf, const MisSums& camera,
+                                const VertexGuides& guides) {
+  const float bsdf_fwd =
+      light.is_delta() ? 0.f : direction_pdf(bsdf, guides, si.wo, ls.wi, TransportMode::Radiance);
+  const float bsdf_rev = direction_pdf(bsdf, guides, ls.wi, si.wo, TransportMode::Importance);
   // Delta positions have area density 1: in solid angle at si that is dist^2.
   const float direct_w =
       pmf * (light.type() == LightType::DeltaPosition ? ls.distance * ls.distance : ls.pdf_w);
@@ -68,36 +70,43 @@ TechniqueTerms terms_next_event(const MisRules& rules, const Light& light, float
 TechniqueTerms terms_connection(const MisRules& rules, const SurfaceInteraction& light_si,
                                 const Bsdf& light_bsdf, Vec3 light_wo, const MisSums& light,
                                 const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
-                                const MisSums& camera) {
+                                const MisSums& camera, const VertexGuides& light_guides,
+                                const VertexGuides& camera_guides) {
   const Vec3 d = light_si.p - camera_si.p;
   const float dist2 = length_squared(d);
   const Vec3 dir = d / std::sqrt(dist2);  // camera vertex -> light vertex
-  const float camera_pdf_a = camera_bsdf.pdf(camera_si.wo, dir, TransportMode::Radiance) *
-                             geometric_cos(light_si, dir) / dist2;
-  const float camera_rev = camera_bsdf.pdf(dir, camera_si.wo, TransportMode::Importance);
-  const float light_pdf_a = light_bsdf.pdf(light_wo, -dir, TransportMode::Importance) *
+  const VertexGuides& cg = camera_guides;
+  const VertexGuides& lg = light_guides;
+  const float camera_pdf_a =
+      direction_pdf(camera_bsdf, cg, camera_si.wo, dir, TransportMode::Radiance) *
+      geometric_cos(light_si, dir) / dist2;
+  const float camera_rev =
+      direction_pdf(camera_bsdf, cg, dir, camera_si.wo, TransportMode::Importance);
+  const float light_pdf_a = direction_pdf(light_bsdf, lg, light_wo, -dir, TransportMode::Importance) *
                             geometric_cos(camera_si, dir) / dist2;
-  const float light_rev = light_bsdf.pdf(-dir, light_wo, TransportMode::Radiance);
+  const float light_rev = direction_pdf(light_bsdf, lg, -dir, light_wo, TransportMode::Radiance);
   return rules.connect(light, camera, camera_pdf_a, camera_rev, light_pdf_a, light_rev);
 }
 
 TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera,
                                      const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
-                                     const MisSums& light, Vec3 p_lens, float raster_density) {
+                                     const MisSums& light, Vec3 p_lens, float raster_density,
+                                     const VertexGuides& guides) {
   const Vec3 d = p_lens - si.p;
   const float dist2 = length_squared(d);
   const Vec3 dir = d / std::sqrt(dist2);
   const float camera_pdf_a =
       camera_pdf_w(camera, p_lens, -dir, raster_density) * geometric_cos(si, dir) / dist2;
-  const float rev = bsdf.pdf(dir, wo, TransportMode::Radiance);
+  const float rev = direction_pdf(bsdf, guides, dir, wo, TransportMode::Radiance);
   return rules.light_to_camera(light, camera_pdf_a, rev);
 }
 
 TechniqueTerms terms_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,
                            const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
-                           const MisSums& camera) {
-  const float fwd = camera_bsdf.pdf(camera_si.wo, light_wo, TransportMode::Radiance);
-  const float rev = camera_bsdf.pdf(light_wo, camera_si.wo, TransportMode::Importance);
+                           const MisSums& camera, const VertexGuides& camera_guides) {
+  const VertexGuides& g = camera_guides;
+  const float fwd = direction_pdf(camera_bsdf, g, camera_si.wo, light_wo, TransportMode::Radiance);
+  const float rev = direction_pdf(camera_bsdf, g, light_wo, camera_si.wo, TransportMode::Importance);
   return rules.merge(light, camera, fwd, rev);
 }
 

@@ -2,12 +2,15 @@
 // vertices' hit records and BSDFs: the one place where geometry becomes the pdfs that MisRules
 // combines. The weight is terms.weight(rules.counts()); adaptive-vcm also evaluates the same
 // terms under other counts. The renderer and the tests' path replay (path_weights.h) both call
-// these, so the partition-of-unity test exercises exactly the code that renders.
+// these, so the partition-of-unity test exercises exactly the code that renders. The guides of a
+// vertex (vertex_guides.h; guided-bpt and guided-vcm) make its densities the guided mixtures';
+// left empty, they are the BSDF's.
 #pragma once
 
 #include "core/vec.h"
 #include "geometry/interaction.h"
 #include "integrators/bidir/mis.h"
+#include "integrators/bidir/vertex_guides.h"
 #include "materials/bsdf.h"
 
 namespace caustica {
@@ -33,7 +36,7 @@ MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf
 // Scattering at si from wo into wi; pdf_fwd is the sample's pdf (ignored for specular bounces).
 void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteraction& si,
                     const Bsdf& bsdf, Vec3 wo, Vec3 wi, TransportMode mode, bool specular,
-                    float pdf_fwd);
+                    float pdf_fwd, const VertexGuides& guides = {});
 
 // Camera subpath reaches an emitter: an area light at `hit` (seen from prev_p) or, with hit ==
 // nullptr, an infinite light along dir (leaving prev_p). `camera` is the camera sums at the
@@ -43,20 +46,23 @@ TechniqueTerms terms_emitter_hit(const MisRules& rules, const Light& light, floa
 // Next event estimation from camera vertex (si, bsdf) with wo.
 TechniqueTerms terms_next_event(const MisRules& rules, const Light& light, float pmf,
                                 const LightLiSample& ls, const SurfaceInteraction& si,
-                                const Bsdf& bsdf, const MisSums& camera);
+                                const Bsdf& bsdf, const MisSums& camera,
+                                const VertexGuides& guides = {});
 // Connection of light vertex (light_si with its wo, BSDF, sums) and camera vertex.
 TechniqueTerms terms_connection(const MisRules& rules, const SurfaceInteraction& light_si,
                                 const Bsdf& light_bsdf, Vec3 light_wo, const MisSums& light,
                                 const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
-                                const MisSums& camera);
+                                const MisSums& camera, const VertexGuides& light_guides = {},
+                                const VertexGuides& camera_guides = {});
 // Light vertex connected to the lens point p_lens, splatted to a pixel whose camera technique
 // has raster density raster_density there (camera_pdf_w).
 TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera,
                                      const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
-                                     const MisSums& light, Vec3 p_lens, float raster_density = 1.f);
+                                     const MisSums& light, Vec3 p_lens, float raster_density = 1.f,
+                                     const VertexGuides& guides = {});
 // Merge of a light vertex that arrived along light_wo with a camera vertex.
 TechniqueTerms terms_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,
                            const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,
-                           const MisSums& camera);
+                           const MisSums& camera, const VertexGuides& camera_guides = {});
 
 }  // namespace caustica::bidir

@@ -1,0 +1,133 @@
+#include "integrators/bidir/bidir_guiding.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <bit>
+
+#include "core/rng.h"
+
+namespace caustica::bidir {
+
+namespace {
+
+constexpr uint64_t kKeysPerPixel = 256;  // camera records: pixel * 256 + depth (depth <= 255)
+constexpr float kDefaultBsdfFraction = 0.5f;
+
+}  // namespace
+
+void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint64_t pixels) {
+  enabled_ = true;
+  if (settings.bsdf_fraction < 0) settings.bsdf_fraction = kDefaultBsdfFraction;
+  settings.max_bytes /= 2;
+  radiance_ = GuidingField(bounds, settings);
+  importance_ = GuidingField(bounds, settings);
+  pass_ = 0;
+  iteration_ = 0;
+  // About four camera vertices per path: one pixel in k keeps the records under kMaxRecords.
+  camera_stride_ = std::max<uint64_t>(1, (4 * pixels + kMaxRecords - 1) / kMaxRecords);
+  radiance_records_ = importance_records_ = 0;
+}
+
+void BidirGuiding::begin_iteration(uint32_t iteration) {
+  iteration_ = iteration;
+  const int pass = std::bit_width(uint64_t(iteration) + 1) - 1;
+  if (pass > pass_) {
+    radiance_.end_pass(pass_);
+    importance_.end_pass(pass_);
+    pass_ = pass;
+  }
+  for (std::vector<GuidingRecord>& r : camera_records_) r.clear();
+}
+
+VertexGuides BidirGuiding::at(Vec3 p, const Bsdf& bsdf) const {
+  VertexGuides g;
+  if (!enabled_ || is_specular(bsdf.flags()) || bsdf.is_delta() || bsdf.stochastic()) return g;
+  const GuidingField::Guide& r = radiance_.guide(radiance_.leaf_at(p));
+  const GuidingField::Guide& i = importance_.guide(importance_.leaf_at(p));
+  g.radiance = r.distribution;
+  g.radiance_bsdf = r.bsdf_fraction;
+  g.importance = i.distribution;
+  g.importance_bsdf = i.bsdf_fraction;
+  return g;
+}
+
+GuidingRecord BidirGuiding::record_at(const GuidingField& field, uint64_t key, Vec3 p, Vec3 wo,
+                                      float value) const {
+  GuidingRecord r;
+  r.key = key;
+  r.leaf = field.leaf_at(p);
+  if (field.settings().filter) {
+    // The spatial box filter's jitter, hashed from the key (a thread-independent sample).
+    const uint64_t h = mix_bits(key ^ (uint64_t(iteration_) << 40) ^ 0x5bd1e995ull);
+    const Vec3 u(float(h & 0xfffff) * 0x1p-20f, float((h >> 20) & 0xfffff) * 0x1p-20f,
+                 float((h >> 40) & 0xfffff) * 0x1p-20f);
+    r.leaf = field.jittered_leaf(p, r.leaf, u);
+  }
+  r.square = direction_to_square(wo);
+  r.radiance = value;
+  r.product = 0;
+  r.guide_pdf = 0;  // no selection gradient: the BSDF fraction is fixed
+  return r;
+}
+
+void BidirGuiding::record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 wo,
+                                        Rgb beta) const {
+  const float value = beta.luminance();
+  if (!(value > 0) || !std::isfinite(value)) return;
+  camera_records_.local().push_back(
+      record_at(importance_, pixel * kKeysPerPixel + uint64_t(depth), p, wo, value));
+}
+
+void BidirGuiding::learn(GuidingField& field, std::vector<GuidingRecord>& records, float stride) {
+  // Every record stands for `stride` vertices: in the split rule's counts and in its value.
+  std::vector<uint32_t> counts(field.leaf_count(), 0);
+  for (GuidingRecord& r : records) {
+    counts[r.leaf] += uint32_t(stride);
+    r.radiance *= stride;
+  }
+  field.add_vertex_counts(counts);
+  field.splat(records);
+}
+
+void BidirGuiding::end_iteration(const std::vector<LightVertex>& light_vertices) {
+  // Radiance from the light vertices: every k-th one, shifted by the iteration.
+  const size_t n = light_vertices.size();
+  const size_t stride = std::max<size_t>(1, (n + kMaxRecords - 1) / kMaxRecords);
+  const size_t first = n ? size_t(iteration_) % stride : 0;
+  const size_t count = first < n ? (n - first + stride - 1) / stride : 0;
+  merged_.resize(count);
+  tbb::parallel_for(size_t(0), count, [&](size_t j) {
+    const size_t i = first + j * stride;
+    const LightVertexData v = unpack_light_vertex(light_vertices[i]);
+    merged_[j] = record_at(radiance_, i, v.p, v.wo, v.throughput.luminance());
+  });
+  std::erase_if(merged_, [](const GuidingRecord& r) {
+    return !(r.radiance > 0) || !std::isfinite(r.radiance);
+  });
+  radiance_records_ += merged_.size();
+  learn(radiance_, merged_, float(stride));
+
+  merged_.clear();
+  for (const std::vector<GuidingRecord>& r : camera_records_)
+    merged_.insert(merged_.end(), r.begin(), r.end());
+  importance_records_ += merged_.size();
+  learn(importance_, merged_, float(camera_stride_));
+}
+
+void BidirGuiding::report(nlohmann::json& stats) const {
+  nlohmann::json g;
+  g["training_passes_completed"] = pass_;
+  g["radiance_spatial_leaves"] = radiance_.leaf_count();
+  g["importance_spatial_leaves"] = importance_.leaf_count();
+  g["radiance_guiding_bytes"] = radiance_.memory_bytes();
+  g["importance_guiding_bytes"] = importance_.memory_bytes();
+  g["guiding_bytes"] = radiance_.memory_bytes() + importance_.memory_bytes();
+  g["guiding_max_bytes"] = 2 * radiance_.settings().max_bytes;
+  g["radiance_records"] = radiance_records_;
+  g["importance_records"] = importance_records_;
+  g["bsdf_fraction"] = radiance_.settings().bsdf_fraction;
+  stats["guiding"] = g;
+}
+
+}  // namespace caustica::bidir

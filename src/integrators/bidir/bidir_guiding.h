@@ -1,0 +1,81 @@
+// What guided-bpt and guided-vcm learn while rendering: two SD-trees (guiding/guiding_field.h,
+// Müller et al. 2017), one of the incident radiance, which guides camera subpaths, and one of
+// the incident importance, which guides light subpaths (Vorba et al. 2014, "On-line Learning of
+// Parametric Mixture Models for Light Transport Simulation": photons train the radiance,
+// "importons" the importance). Both come from the subpaths the core traces anyway:
+//  - radiance: every stored light vertex (a photon) is a sample of the flux arriving at its
+//    position from its wo, weighted by its throughput: splatted at wo with the luminance of
+//    its throughput;
+//  - importance: every non-delta camera vertex is a sample of the importance arriving from its
+//    wo (toward the camera), weighted by the camera subpath's throughput.
+// The sums over a directional quadrant are flux estimates, as Müller's L_i / pdf records are;
+// they need no backward pass over the paths. At most kMaxRecords per field and iteration are
+// kept (every k-th vertex, weighted by k, the k-th shifted with the iteration), which bounds the
+// memory of the records independently of the resolution.
+//
+// Schedule (as guided-pt): iteration i belongs to training pass floor(log2(i + 1)); a pass
+// samples with what the passes before it learned, so iteration 0 is plain bpt / vcm, and every
+// iteration is an unbiased estimate. The image is the plain average of all iterations.
+//
+// Where a vertex is guided: where the BSDF has no delta or near-specular lobe and is not
+// stochastic (as guided-pt), once its leaf has learned something. The probability of sampling
+// the BSDF instead of the guide is fixed (--guiding-bsdf-fraction, default 0.5): the records
+// carry no product estimate to learn it from. Memory: each field gets half of
+// --guiding-max-mb.
+//
+// Determinism: records are keyed by (pixel, depth) and by light-vertex index, both independent
+// of threads, and GuidingField::splat sorts them.
+#pragma once
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "guiding/guiding_field.h"
+#include "integrators/bidir/light_vertex.h"
+#include "integrators/bidir/vertex_guides.h"
+
+namespace caustica::bidir {
+
+class BidirGuiding {
+ public:
+  static constexpr size_t kMaxRecords = size_t(1) << 18;
+
+  BidirGuiding() = default;
+  void prepare(const Bounds3& bounds, GuidingSettings settings, uint64_t pixels);
+  bool enabled() const { return enabled_; }
+
+  // Before iteration i: ends the training pass when i starts a new one.
+  void begin_iteration(uint32_t iteration);
+  // The guides at a vertex at p with this BSDF (empty where it is not guided).
+  VertexGuides at(Vec3 p, const Bsdf& bsdf) const;
+
+  // Camera vertices of `pixel` are recorded this iteration (one pixel in k).
+  bool records_pixel(uint64_t pixel) const {
+    return (pixel + iteration_) % camera_stride_ == 0;
+  }
+  // The camera subpath of `pixel` reached a non-delta vertex at p, arriving along -wo with
+  // throughput beta (from estimate(): any thread).
+  void record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 wo, Rgb beta) const;
+  // After the camera pass: learns from this iteration's light vertices and camera records.
+  void end_iteration(const std::vector<LightVertex>& light_vertices);
+
+  void report(nlohmann::json& stats) const;
+
+ private:
+  GuidingRecord record_at(const GuidingField& field, uint64_t key, Vec3 p, Vec3 wo,
+                          float value) const;
+  static void learn(GuidingField& field, std::vector<GuidingRecord>& records, float stride);
+
+  bool enabled_ = false;
+  GuidingField radiance_, importance_;
+  int pass_ = 0;
+  uint32_t iteration_ = 0;
+  uint64_t camera_stride_ = 1;
+  uint64_t radiance_records_ = 0, importance_records_ = 0;
+  mutable tbb::enumerable_thread_specific<std::vector<GuidingRecord>> camera_records_;
+  std::vector<GuidingRecord> merged_;
+};
+
+}  // namespace caustica::bidir

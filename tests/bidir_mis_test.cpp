@@ -188,7 +188,8 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
   auto delta = [&](int i) { return bsdf[i].is_delta(); };
   // Guided vertices sample from mixtures (vertex_guides.h): their densities, both ways.
   auto pdf = [&](int i, Vec3 wo, Vec3 wi, TransportMode mode) {
-    const VertexGuides g = guiding ? guiding->at(x[i], bsdf[i]) : VertexGuides{};
+    const VertexGuides g =
+        guiding ? guiding->at(x[i], path.surfaces[i - 1].ng, bsdf[i]) : VertexGuides{};
     return double(direction_pdf(bsdf[i], g, wo, wi, mode));
   };
   // Solid angle -> area at x[to] (x0 of an infinite light stays a direction).
@@ -259,9 +260,10 @@ struct Case {
   bool guided = false;       // guided-bpt / guided-vcm: densities of trained guiding fields
 };
 
-// Fields of guided-bpt / guided-vcm trained on synthetic records over the scene's box: directions
-// concentrated around a different axis for radiance and importance (so that forward and
-// reverse densities differ), a spatial threshold low enough that the trees split.
+// Fields of guided-bpt / guided-vcm trained on synthetic records: surface points hit by rays from
+// random points of the scene's box, with arrival directions biased differently for radiance and
+// importance (so that forward and reverse densities differ), and a spatial threshold low enough
+// that the trees split.
 std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene) {
   auto g = std::make_unique<BidirGuiding>();
   GuidingSettings settings;
@@ -271,21 +273,25 @@ std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene) {
   std::mt19937 gen(5);
   std::uniform_real_distribution<float> u(0.f, 1.f);
   const Bounds3 b = scene.bounds();
-  auto point = [&] {
+  auto hit = [&](Vec3 bias, SurfaceInteraction* si) {
     const Vec3 d = b.diagonal();
-    return b.lo + Vec3(u(gen) * d.x, u(gen) * d.y, u(gen) * d.z);
+    const Vec3 o = b.lo + Vec3(u(gen) * d.x, u(gen) * d.y, u(gen) * d.z);
+    const Vec3 dir = normalize(bias + Vec3(u(gen), u(gen), u(gen)) * 2.f - Vec3(1, 1, 1));
+    Ray ray{o, dir, kInfinity};
+    return scene.intersect(ray, si);
   };
-  auto around = [&](Vec3 axis) { return normalize(axis * 1.5f + Vec3(u(gen), u(gen), u(gen)) - Vec3(0.5f, 0.5f, 0.5f)); };
   for (int pass = 0; pass < 3; ++pass) {
     g->begin_iteration(uint32_t((1u << pass) - 1));
     std::vector<LightVertex> photons;
-    for (int i = 0; i < 4000; ++i) {
-      photons.push_back(pack_light_vertex(
-          {point(), around(Vec3(0, 1, 0)), 0, 1, Rgb(0.1f + u(gen)), MisSums{}}));
-      g->record_camera_vertex(uint64_t(i), 1, point(), around(Vec3(0, 0, -1)),
-                              Rgb(0.1f + u(gen)));
+    for (int i = 0; i < 6000; ++i) {
+      SurfaceInteraction si;
+      if (hit(Vec3(0, -0.8f, 0), &si))
+        photons.push_back(pack_light_vertex(
+            {si.p, si.wo, scene.primitive_index(si), 1, Rgb(0.1f + u(gen)), MisSums{}}));
+      if (hit(Vec3(0.7f, 0, 0), &si))
+        g->record_camera_vertex(uint64_t(i), 1, si.p, si.ng, si.wo, Rgb(0.1f + u(gen)));
     }
-    g->end_iteration(photons);
+    g->end_iteration(scene, photons);
   }
   g->begin_iteration(7);  // ends the last pass: its distributions are sampled from
   return g;
@@ -339,8 +345,9 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
       }
     if (guiding) {
       for (const SurfaceInteraction& si : path.surfaces) {
-        const VertexGuides g = guiding->at(si.p, si.material->bsdf(si, arena));
-        guided_vertices += g.radiance && g.importance;
+        const VertexGuides g = guiding->at(si.p, si.ng, si.material->bsdf(si, arena));
+        guided_vertices += g.guide(TransportMode::Radiance, si.wo) &&
+                           g.guide(TransportMode::Importance, si.wo);
       }
     }
     ASSERT_NEAR(sum, 1.0, 1e-4) << c.scene << " path " << checked << " with " << weights.size()
@@ -349,7 +356,9 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
   }
   EXPECT_EQ(checked, paths) << c.scene << ": could not build enough paths";
   // The guided cases must exercise guided densities: on average a guided vertex per two paths.
-  if (guiding) EXPECT_GT(2 * guided_vertices, paths) << c.scene;
+  if (guiding) {
+    EXPECT_GT(2 * guided_vertices, paths) << c.scene;
+  }
   std::printf(
       "[ partition ] %-14s %d paths (%d through delta vertices), max |sum - 1| = %.2e, max |w - "
       "oracle| = %.2e\n",

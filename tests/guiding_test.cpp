@@ -166,6 +166,43 @@ TEST(Guiding, SpatialTreeSeparatesRegions) {
   EXPECT_GT(b.pdf(right.axis), 20 * b.pdf(left.axis));
 }
 
+// A sided field learns the two faces of a zero-thickness wall separately: radiance recorded on
+// the +x face (class 0) from +x and on the -x face (class 1) from -x, at the same points, gives
+// each face its own distribution, and a point outside the box still stays in its class.
+TEST(Guiding, SidedFieldSeparatesTheFacesOfAThinWall) {
+  GuidingSettings s;
+  s.filter = false;
+  GuidingField field(Bounds3{{0, 0, 0}, {1, 1, 1}}, s, /*sided=*/true);
+  EXPECT_EQ(GuidingField::side_class({1, 0.2f, 0.1f}), 0);
+  EXPECT_EQ(GuidingField::side_class({-1, 0.2f, 0.1f}), 1);
+  EXPECT_EQ(GuidingField::side_class({0.1f, -0.9f, 0.3f}), 3);
+  EXPECT_EQ(GuidingField::side_class({0.1f, 0.2f, 0.9f}), 4);
+  std::vector<GuidingRecord> records;
+  for (uint64_t i = 0; i < 2000; ++i) {
+    const Vec3 p(0.5f, float(i % 40) / 40.f, float(i / 40) / 50.f);  // the wall x = 1/2
+    for (int side = 0; side < 2; ++side) {
+      GuidingRecord r;
+      r.key = 2 * i + uint64_t(side);
+      r.leaf = field.leaf_at(p, side);
+      r.square = direction_to_square(side == 0 ? Vec3(1, 0, 0) : Vec3(-1, 0, 0));
+      r.radiance = 1;
+      records.push_back(r);
+    }
+  }
+  field.splat(records);
+  field.end_pass(0);
+  const Vec3 p(0.5f, 0.5f, 0.5f);
+  ASSERT_NE(field.leaf_at(p, 0), field.leaf_at(p, 1));
+  const DirectionalQuadtree& front = field.sampling(field.leaf_at(p, 0));
+  const DirectionalQuadtree& back = field.sampling(field.leaf_at(p, 1));
+  EXPECT_GT(front.pdf({1, 0, 0}), 10 * front.pdf({-1, 0, 0}));
+  EXPECT_GT(back.pdf({-1, 0, 0}), 10 * back.pdf({1, 0, 0}));
+  // Nothing was recorded for the other classes, and points beyond the box keep their class.
+  EXPECT_EQ(field.sampling(field.leaf_at(p, 2)).total(), 0);
+  EXPECT_EQ(field.leaf_at({7.f, 0.5f, 0.5f}, 0), field.leaf_at({0.99f, 0.5f, 0.5f}, 0));
+  EXPECT_EQ(field.leaf_at({-3.f, 0.5f, 0.5f}, 1), field.leaf_at({0.01f, 0.5f, 0.5f}, 1));
+}
+
 // The memory cap bounds the whole structure, and memory is reported.
 TEST(Guiding, MemoryCapBoundsTheStructure) {
   GuidingSettings s;

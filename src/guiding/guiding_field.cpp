@@ -23,20 +23,53 @@ uint64_t mix_bits(uint64_t x) {
 
 }  // namespace
 
-GuidingField::GuidingField(Bounds3 bounds, const GuidingSettings& settings)
-    : settings_(settings), bounds_(bounds.empty() ? Bounds3{{0, 0, 0}, {1, 1, 1}} : bounds) {
+GuidingField::GuidingField(Bounds3 bounds, const GuidingSettings& settings, bool sided)
+    : settings_(settings),
+      bounds_(bounds.empty() ? Bounds3{{0, 0, 0}, {1, 1, 1}} : bounds),
+      sided_(sided) {
   nodes_.emplace_back();  // a leaf: leaves_[0]
   leaves_.emplace_back();
   leaves_[0].box = bounds_;
   counts_.assign(1, 0);
+  if (sided_) {
+    // Eight copies side by side along x (a flat box gets a width, so that they stay apart), then
+    // three rounds of splits along x: the midpoints are the copies' borders, one leaf each.
+    const Vec3 d = bounds_.diagonal();
+    copy_width_ = std::max(d.x, 1e-3f * std::max({d.x, d.y, d.z, 1e-3f}));
+    leaves_[0].box.hi.x = bounds_.lo.x + 8 * copy_width_;
+    for (int round = 0; round < 3; ++round) {
+      const size_t n = nodes_.size();
+      for (uint32_t i = 0; i < n; ++i)
+        if (nodes_[i].axis() == SpatialNode::kLeaf) split(i, counts_, 0);
+    }
+    std::fill(counts_.begin(), counts_.end(), 0);
+  }
   refresh_guides();
+}
+
+int GuidingField::side_class(Vec3 n) {
+  const float ax = std::abs(n.x), ay = std::abs(n.y), az = std::abs(n.z);
+  const int axis = ax >= ay && ax >= az ? 0 : (ay >= az ? 1 : 2);
+  return 2 * axis + (n[axis] < 0 ? 1 : 0);
+}
+
+Vec3 GuidingField::class_point(Vec3 p, int side) const {
+  if (!sided_) return p;
+  // Kept a sliver inside the copy, so that float rounding of the split planes at the copies'
+  // borders never moves a point into the neighbouring class.
+  const float t = std::clamp((p.x - bounds_.lo.x) / copy_width_, 5e-4f, 1 - 5e-4f);
+  return {bounds_.lo.x + (float(side) + t) * copy_width_, p.y, p.z};
 }
 
 void GuidingField::add_vertex_counts(const std::vector<uint32_t>& counts) {
   for (size_t i = 0; i < counts.size() && i < counts_.size(); ++i) counts_[i] += counts[i];
 }
 
-uint32_t GuidingField::leaf_at(Vec3 p) const {
+uint32_t GuidingField::leaf_at(Vec3 p, int side) const {
+  return leaf_of_point(class_point(p, side));
+}
+
+uint32_t GuidingField::leaf_of_point(Vec3 p) const {
   const float coordinate[4] = {p.x, p.y, p.z, 0};  // indexed without branches
   SpatialNode n = nodes_[0];
   while (n.axis() != SpatialNode::kLeaf) n = nodes_[n.index() + (coordinate[n.axis()] >= n.middle)];
@@ -54,9 +87,9 @@ void GuidingField::refresh_guides() {
   }
 }
 
-uint32_t GuidingField::jittered_leaf(Vec3 p, uint32_t leaf, Vec3 u) const {
+uint32_t GuidingField::jittered_leaf(Vec3 p, uint32_t leaf, Vec3 u, int side) const {
   const Vec3 size = leaves_[leaf].box.diagonal();
-  return leaf_at(p + (u - Vec3(0.5f, 0.5f, 0.5f)) * size);
+  return leaf_at(p + (u - Vec3(0.5f, 0.5f, 0.5f)) * size, side);
 }
 
 float GuidingField::bsdf_fraction(uint32_t leaf) const {
@@ -146,11 +179,12 @@ void GuidingField::radix_sort_by_key(std::vector<GuidingRecord>& records, int bi
 
 // Müller et al. 2017, sec. 3.4: "we subdivide a leaf node if it contains more than
 // c sqrt(2^k) path vertices"; the children inherit the directional distributions.
-void GuidingField::split(uint32_t node, std::vector<uint64_t>& counts) {
+void GuidingField::split(uint32_t node, std::vector<uint64_t>& counts, int split_axis) {
   const uint32_t leaf = nodes_[node].index();
   const Bounds3 box = leaves_[leaf].box;
   const Vec3 d = box.diagonal();
-  const uint32_t axis = d.x >= d.y && d.x >= d.z ? 0 : (d.y >= d.z ? 1 : 2);
+  const uint32_t axis = split_axis >= 0 ? uint32_t(split_axis)
+                                        : (d.x >= d.y && d.x >= d.z ? 0 : (d.y >= d.z ? 1 : 2));
   const float middle = 0.5f * (box.lo[int(axis)] + box.hi[int(axis)]);
   counts[leaf] /= 2;
   const uint32_t copy = uint32_t(leaves_.size());

@@ -54,13 +54,26 @@ struct GuidingRecord {
 class GuidingField {
  public:
   GuidingField() : GuidingField(Bounds3{{0, 0, 0}, {1, 1, 1}}, {}) {}
-  GuidingField(Bounds3 bounds, const GuidingSettings& settings);
+  // sided: the field is kept once per side class (side_class(): six classes of the normal on the
+  // side a vertex is seen from), so that the two faces of a thin wall, or a floor and the wall
+  // it meets, learn and sample separate distributions. One guide for both faces of a
+  // zero-thickness wall sent a third of guided-pt's guided directions, and half of guided
+  // bidirectional ones, below the surface (f = 0) on door-ajar. Implemented as eight copies of
+  // the box side by side along x, one per class, split apart before anything is learned; the
+  // spatial tree, its split rule and the memory cap are shared.
+  GuidingField(Bounds3 bounds, const GuidingSettings& settings, bool sided = false);
 
-  // The leaf whose box holds p (points outside the box go to the nearest leaf).
-  uint32_t leaf_at(Vec3 p) const;
+  // The side class of a normal n facing the side a vertex is seen from: 2 * (the axis of its
+  // largest component) + (that component < 0). The other side of the surface is class ^ 1.
+  static int side_class(Vec3 n);
+  static constexpr int kSideClasses = 6;
+
+  // The leaf whose box holds p (points outside the box go to the nearest leaf), in the copy of
+  // side class `side` (0 unless the field is sided).
+  uint32_t leaf_at(Vec3 p, int side = 0) const;
   // The leaf of p moved by (u - 1/2) times the size of the box of `leaf` (p's leaf): a sample of
-  // the box filter of the spatial splat (Müller 2019). u in [0, 1)^3.
-  uint32_t jittered_leaf(Vec3 p, uint32_t leaf, Vec3 u) const;
+  // the box filter of the spatial splat (Müller 2019). u in [0, 1)^3. It stays in p's class.
+  uint32_t jittered_leaf(Vec3 p, uint32_t leaf, Vec3 u, int side = 0) const;
   // The distribution learned for the leaf; its total() is 0 until some radiance was recorded.
   const DirectionalQuadtree& sampling(uint32_t leaf) const { return leaves_[leaf].sampling; }
   // The probability of sampling the BSDF at the leaf (fixed, or learned: guiding_settings.h).
@@ -112,12 +125,18 @@ class GuidingField {
   };
   void record_into(Leaf& leaf, const GuidingRecord& r);
   void radix_sort_by_key(std::vector<GuidingRecord>& records, int bits);
-  void split(uint32_t node, std::vector<uint64_t>& counts);
+  // Splits a leaf node in two at the middle of `axis` (-1: its box's longest axis).
+  void split(uint32_t node, std::vector<uint64_t>& counts, int axis = -1);
+  uint32_t leaf_of_point(Vec3 p) const;
+  // p clamped into the scene's box along x and moved into the copy of its side class.
+  Vec3 class_point(Vec3 p, int side) const;
   void split_leaves(int k);
   size_t leaf_bytes(const Leaf& l) const;
 
   GuidingSettings settings_;
-  Bounds3 bounds_;
+  Bounds3 bounds_;         // the scene's box (copy 0)
+  float copy_width_ = 0;   // sided: the x extent of one copy
+  bool sided_ = false;
   std::vector<SpatialNode> nodes_;  // nodes_[0] is the root
   std::vector<Leaf> leaves_;
   std::vector<uint64_t> counts_;        // path vertices per leaf in the current pass

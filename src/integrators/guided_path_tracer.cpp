@@ -92,13 +92,17 @@ std::optional<MixtureSample> sample_mixture(const Bsdf& bsdf, Vec3 wo, const Mix
 }
 
 // The mixture at a vertex at p: guided where the BSDF has neither delta nor near-specular lobes
-// and is not stochastic, with the distribution and selection probability of p's leaf; its
+// and is not stochastic, with the distribution and selection probability of p's leaf on the
+// side the path arrived from (GuidingField::side_class of the geometric normal facing wo); its
 // records go to the leaf of p jittered by the leaf's size (the spatial box filter).
-Mixture mixture_at(const GuidingField& field, bool filter, Vec3 p, const Bsdf& bsdf, Pcg32& rng) {
+Mixture mixture_at(const GuidingField& field, bool filter, const SurfaceInteraction& si,
+                   const Bsdf& bsdf, Pcg32& rng) {
   Mixture mix;
   mix.guidable = !is_specular(bsdf.flags()) && !bsdf.is_delta() && !bsdf.stochastic();
   if (!mix.guidable) return mix;
-  const uint32_t leaf = field.leaf_at(p);
+  const Vec3 p = si.p;
+  const int side = GuidingField::side_class(face_forward(si.ng, si.wo));
+  const uint32_t leaf = field.leaf_at(p, side);
   const GuidingField::Guide& guide = field.guide(leaf);
   if (guide.distribution) {
     mix.guide = guide.distribution;
@@ -107,7 +111,7 @@ Mixture mixture_at(const GuidingField& field, bool filter, Vec3 p, const Bsdf& b
   mix.record_leaf = leaf;
   if (filter) {
     const float ux = rng.next_float(), uy = rng.next_float(), uz = rng.next_float();
-    mix.record_leaf = field.jittered_leaf(p, leaf, Vec3(ux, uy, uz));
+    mix.record_leaf = field.jittered_leaf(p, leaf, Vec3(ux, uy, uz), side);
   }
   return mix;
 }
@@ -193,7 +197,7 @@ int GuidedPathTracer::training_pass(uint32_t iteration) {
 
 void GuidedPathTracer::prepare(const Scene& scene, Film& film) {
   CameraPathIntegrator::prepare(scene, film);
-  field_ = GuidingField(scene.bounds(), settings_.guiding);
+  field_ = GuidingField(scene.bounds(), settings_.guiding, /*sided=*/true);
   passes_ = InverseVarianceCombiner(scene.camera().width(), scene.camera().height());
   pass_ = 0;
   recorded_ = 0;
@@ -262,7 +266,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     if (depth++ == settings_.max_depth) break;
 
     const Vec3 wo = si.wo;
-    const Mixture mix = mixture_at(field_, settings_.guiding.filter, si.p, bsdf, rng);
+    const Mixture mix = mixture_at(field_, settings_.guiding.filter, si, bsdf, rng);
     // Next event estimation asks for the mixture density toward the light (not for a delta
     // light); what it evaluated is kept for the record.
     DirectionPdfs nee_pdfs;

@@ -108,16 +108,16 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
 
     const bool delta = bsdf.is_delta();
     ++acc.work.camera_vertices;
-    const VertexGuides guides = tech_.guided ? guiding_.at(si.p, bsdf) : VertexGuides{};
+    const VertexGuides guides = tech_.guided ? guiding_.at(si.p, si.ng, bsdf) : VertexGuides{};
     if (!delta) {
       vertex_techniques(scene, it, {si, bsdf, beta, mis, depth, guides}, light_path, rng, arena,
                         acc);
       if (tech_.guided && guiding_.records_pixel(pixel))
-        guiding_.record_camera_vertex(pixel, depth, si.p, si.wo, beta);
+        guiding_.record_camera_vertex(pixel, depth, si.p, si.ng, si.wo, beta);
     }
 
     Vec3 wi;
-    if (guides.radiance) {
+    if (guides.guide(TransportMode::Radiance, si.wo)) {
       // guided: the mixture of the BSDF and the learned radiance (vertex_guides.h)
       const float u_technique = rng.next_float(), uc = rng.next_float();
       const auto gs = sample_guided(bsdf, guides, si.wo, TransportMode::Radiance, u_technique, uc,
@@ -232,7 +232,7 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
     if (f_light.is_black()) continue;
     ++acc.work.connections;
     const VertexGuides light_guides =
-        tech_.guided ? guiding_.at(light_si.p, light_bsdf) : VertexGuides{};
+        tech_.guided ? guiding_.at(light_si.p, light_si.ng, light_bsdf) : VertexGuides{};
     const TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf,
                                                   cv.mis, light_guides, cv.guides);
     const float w = terms.weight(rules.counts());

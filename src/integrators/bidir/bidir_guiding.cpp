@@ -6,6 +6,7 @@
 #include <bit>
 
 #include "core/rng.h"
+#include "scene/scene.h"
 
 namespace caustica::bidir {
 
@@ -20,8 +21,8 @@ void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint
   enabled_ = true;
   if (settings.bsdf_fraction < 0) settings.bsdf_fraction = kDefaultBsdfFraction;
   settings.max_bytes /= 2;
-  radiance_ = GuidingField(bounds, settings);
-  importance_ = GuidingField(bounds, settings);
+  radiance_ = GuidingField(bounds, settings, /*sided=*/true);
+  importance_ = GuidingField(bounds, settings, /*sided=*/true);
   pass_ = 0;
   iteration_ = 0;
   // About four camera vertices per path: one pixel in k keeps the records under kMaxRecords.
@@ -40,29 +41,41 @@ void BidirGuiding::begin_iteration(uint32_t iteration) {
   for (std::vector<GuidingRecord>& r : camera_records_) r.clear();
 }
 
-VertexGuides BidirGuiding::at(Vec3 p, const Bsdf& bsdf) const {
+VertexGuides BidirGuiding::at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const {
   VertexGuides g;
   if (!enabled_ || is_specular(bsdf.flags()) || bsdf.is_delta() || bsdf.stochastic()) return g;
-  const GuidingField::Guide& r = radiance_.guide(radiance_.leaf_at(p));
-  const GuidingField::Guide& i = importance_.guide(importance_.leaf_at(p));
-  g.radiance = r.distribution;
-  g.radiance_bsdf = r.bsdf_fraction;
-  g.importance = i.distribution;
-  g.importance_bsdf = i.bsdf_fraction;
+  g.fields = this;
+  g.p = p;
+  g.n = ng;
   return g;
 }
 
-GuidingRecord BidirGuiding::record_at(const GuidingField& field, uint64_t key, Vec3 p, Vec3 wo,
-                                      float value) const {
+void VertexGuides::resolve(int side) const {
+  const int front = GuidingField::side_class(n);
+  const int c = side ? front ^ 1 : front;  // -n: the same axis, the other sign
+  const GuidingField& radiance = fields->radiance_;
+  const GuidingField& importance = fields->importance_;
+  const GuidingField::Guide& r = radiance.guide(radiance.leaf_at(p, c));
+  const GuidingField::Guide& i = importance.guide(importance.leaf_at(p, c));
+  guides[int(TransportMode::Radiance)][side] = r.distribution;
+  bsdf[int(TransportMode::Radiance)][side] = r.bsdf_fraction;
+  guides[int(TransportMode::Importance)][side] = i.distribution;
+  bsdf[int(TransportMode::Importance)][side] = i.bsdf_fraction;
+  resolved |= uint8_t(1u << side);
+}
+
+GuidingRecord BidirGuiding::record_at(const GuidingField& field, uint64_t key, Vec3 p, Vec3 ng,
+                                      Vec3 wo, float value) const {
+  const int side = GuidingField::side_class(face_forward(ng, wo));
   GuidingRecord r;
   r.key = key;
-  r.leaf = field.leaf_at(p);
+  r.leaf = field.leaf_at(p, side);
   if (field.settings().filter) {
     // The spatial box filter's jitter, hashed from the key (a thread-independent sample).
     const uint64_t h = mix_bits(key ^ (uint64_t(iteration_) << 40) ^ 0x5bd1e995ull);
     const Vec3 u(float(h & 0xfffff) * 0x1p-20f, float((h >> 20) & 0xfffff) * 0x1p-20f,
                  float((h >> 40) & 0xfffff) * 0x1p-20f);
-    r.leaf = field.jittered_leaf(p, r.leaf, u);
+    r.leaf = field.jittered_leaf(p, r.leaf, u, side);
   }
   r.square = direction_to_square(wo);
   r.radiance = value;
@@ -71,12 +84,12 @@ GuidingRecord BidirGuiding::record_at(const GuidingField& field, uint64_t key, V
   return r;
 }
 
-void BidirGuiding::record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 wo,
+void BidirGuiding::record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 ng, Vec3 wo,
                                         Rgb beta) const {
   const float value = beta.luminance();
   if (!(value > 0) || !std::isfinite(value)) return;
   camera_records_.local().push_back(
-      record_at(importance_, pixel * kKeysPerPixel + uint64_t(depth), p, wo, value));
+      record_at(importance_, pixel * kKeysPerPixel + uint64_t(depth), p, ng, wo, value));
 }
 
 void BidirGuiding::learn(GuidingField& field, std::vector<GuidingRecord>& records, float stride) {
@@ -90,7 +103,8 @@ void BidirGuiding::learn(GuidingField& field, std::vector<GuidingRecord>& record
   field.splat(records);
 }
 
-void BidirGuiding::end_iteration(const std::vector<LightVertex>& light_vertices) {
+void BidirGuiding::end_iteration(const Scene& scene,
+                                 const std::vector<LightVertex>& light_vertices) {
   // Radiance from the light vertices: every k-th one, shifted by the iteration.
   const size_t n = light_vertices.size();
   const size_t stride = std::max<size_t>(1, (n + kMaxRecords - 1) / kMaxRecords);
@@ -100,7 +114,8 @@ void BidirGuiding::end_iteration(const std::vector<LightVertex>& light_vertices)
   tbb::parallel_for(size_t(0), count, [&](size_t j) {
     const size_t i = first + j * stride;
     const LightVertexData v = unpack_light_vertex(light_vertices[i]);
-    merged_[j] = record_at(radiance_, i, v.p, v.wo, v.throughput.luminance());
+    const Vec3 ng = scene.interaction_at(v.primitive, v.p, v.wo).ng;
+    merged_[j] = record_at(radiance_, i, v.p, ng, v.wo, v.throughput.luminance());
   });
   std::erase_if(merged_, [](const GuidingRecord& r) {
     return !(r.radiance > 0) || !std::isfinite(r.radiance);

@@ -17,11 +17,14 @@
 // samples with what the passes before it learned, so iteration 0 is plain bpt / vcm, and every
 // iteration is an unbiased estimate. The image is the plain average of all iterations.
 //
+// Sides: both fields are sided (GuidingField::side_class: the geometric normal facing the side a
+// record arrived on), so that the two faces of a thin wall, or a floor and the wall it meets, do
+// not share a distribution; a subpath arriving on one side samples that side's (vertex_guides.h).
+//
 // Where a vertex is guided: where the BSDF has no delta or near-specular lobe and is not
 // stochastic (as guided-pt), once its leaf has learned something. The probability of sampling
 // the BSDF instead of the guide is fixed (--guiding-bsdf-fraction, default 0.5): the records
-// carry no product estimate to learn it from. Memory: each field gets half of
-// --guiding-max-mb.
+// carry no product estimate to learn it from. Memory: each field gets half of --guiding-max-mb.
 //
 // Determinism: records are keyed by (pixel, depth) and by light-vertex index, both independent
 // of threads, and GuidingField::splat sorts them.
@@ -36,6 +39,10 @@
 #include "integrators/bidir/light_vertex.h"
 #include "integrators/bidir/vertex_guides.h"
 
+namespace caustica {
+class Scene;
+}
+
 namespace caustica::bidir {
 
 class BidirGuiding {
@@ -48,23 +55,27 @@ class BidirGuiding {
 
   // Before iteration i: ends the training pass when i starts a new one.
   void begin_iteration(uint32_t iteration);
-  // The guides at a vertex at p with this BSDF (empty where it is not guided).
-  VertexGuides at(Vec3 p, const Bsdf& bsdf) const;
+  // The guides at a vertex at p with geometric normal ng and this BSDF (empty where it is not
+  // guided).
+  VertexGuides at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const;
 
   // Camera vertices of `pixel` are recorded this iteration (one pixel in k).
   bool records_pixel(uint64_t pixel) const {
     return (pixel + iteration_) % camera_stride_ == 0;
   }
-  // The camera subpath of `pixel` reached a non-delta vertex at p, arriving along -wo with
-  // throughput beta (from estimate(): any thread).
-  void record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 wo, Rgb beta) const;
-  // After the camera pass: learns from this iteration's light vertices and camera records.
-  void end_iteration(const std::vector<LightVertex>& light_vertices);
+  // The camera subpath of `pixel` reached a non-delta vertex at p (geometric normal ng),
+  // arriving along -wo with throughput beta (from estimate(): any thread).
+  void record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 ng, Vec3 wo, Rgb beta) const;
+  // After the camera pass: learns from this iteration's light vertices (their normals from the
+  // scene) and camera records.
+  void end_iteration(const Scene& scene, const std::vector<LightVertex>& light_vertices);
 
   void report(nlohmann::json& stats) const;
 
  private:
-  GuidingRecord record_at(const GuidingField& field, uint64_t key, Vec3 p, Vec3 wo,
+  friend struct VertexGuides;
+  // A record of `value` arriving at p (geometric normal ng) along -wo.
+  GuidingRecord record_at(const GuidingField& field, uint64_t key, Vec3 p, Vec3 ng, Vec3 wo,
                           float value) const;
   static void learn(GuidingField& field, std::vector<GuidingRecord>& records, float stride);
 

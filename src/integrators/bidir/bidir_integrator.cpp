@@ -133,7 +133,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   const auto camera_start = std::chrono::steady_clock::now();
   trace_camera_paths(scene, iteration, film);
   camera_seconds_total_ += seconds_since(camera_start);
-  if (tech_.guided) guiding_.end_iteration(vertices_);
+  if (tech_.guided) guiding_.end_iteration(scene, vertices_);
   probe_.light_vertices = double(vertices_.size());
   add_counts(work_total_, probe_);
   if (it.plan.probe) {

@@ -163,7 +163,7 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
     segment = 0;
     if (depth > max_depth) break;
 
-    const VertexGuides guides = tech_.guided ? guiding_.at(si.p, bsdf) : VertexGuides{};
+    const VertexGuides guides = tech_.guided ? guiding_.at(si.p, si.ng, bsdf) : VertexGuides{};
     if (!bsdf.is_delta()) {
       if (stores_vertices()) {
         chunk.vertices.push_back(
@@ -175,7 +175,7 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
     if (depth + 1 > max_depth) break;
 
     Vec3 wi;
-    if (guides.importance) {
+    if (guides.guide(TransportMode::Importance, si.wo)) {
       // guided: the mixture of the BSDF and the learned importance (vertex_guides.h)
       const float u_technique = rng.next_float(), uc = rng.next_float();
       const auto gs = sample_guided(bsdf, guides, si.wo, TransportMode::Importance, u_technique,

@@ -47,7 +47,7 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   }
   auto delta = [&](int i) { return bsdf[i].is_delta(); };
   std::vector<VertexGuides> guides(k);
-  for (int i = 1; guiding && i < k; ++i) guides[i] = guiding->at(x[i], bsdf[i]);
+  for (int i = 1; guiding && i < k; ++i) guides[i] = guiding->at(x[i], path.surfaces[i - 1].ng, bsdf[i]);
 
   // Light subpath replay: sums at x1..x(k-1), stored and reloaded as the renderer does.
   LightLeSample le;

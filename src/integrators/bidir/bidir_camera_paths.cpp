@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include "integrators/bidir/bidir_core.h"
+#include "integrators/bidir/subpath_step.h"
 #include "integrators/path_vertex.h"
 #include "lights/light.h"
 #include "lights/light_sampler.h"
@@ -116,42 +117,17 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
         guiding_.record_camera_vertex(pixel, depth, si.p, si.ng, si.wo, beta);
     }
 
-    Vec3 wi;
-    if (guides.guide(TransportMode::Radiance, si.wo)) {
-      // guided: the mixture of the BSDF and the learned radiance (vertex_guides.h)
-      const float u_technique = rng.next_float(), uc = rng.next_float();
-      const auto gs = sample_guided(bsdf, guides, si.wo, TransportMode::Radiance, u_technique, uc,
-                                    rng.next_2d());
-      if (!gs) break;
-      wi = gs->wi;
-      scatter_update(rules, mis, si, bsdf, si.wo, wi, TransportMode::Radiance, false, gs->pdf,
-                     guides);
-      beta *= gs->weight;
-      rr_beta *= gs->bsdf_weight;
-      specular_path = false;
-      eta_scale *= sqr(gs->eta);
-    } else {
-      const float uc = rng.next_float();
-      const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Radiance);
-      if (!bs) break;
-      // PPM / lt: the non-delta part of this vertex was estimated by merging (or belongs to
-      // light tracing); only its delta lobes carry the camera path on.
-      if (tech_.camera_stops && !delta && !bs->is_specular()) break;
-      wi = bs->wi;
-      const float pdf_fwd =
-          bs->pdf_is_proportional ? direction_pdf(bsdf, guides, si.wo, wi, TransportMode::Radiance)
-                                  : bs->pdf;
-      scatter_update(rules, mis, si, bsdf, si.wo, wi, TransportMode::Radiance, bs->is_specular(),
-                     pdf_fwd, guides);
-      const Rgb weight = bs->f * (bsdf.abs_cos(wi) / bs->pdf);
-      beta *= weight;
-      rr_beta *= weight;
-      specular_path = specular_path && bs->is_specular();
-      if (bs->is_transmission()) eta_scale *= sqr(bs->eta);
-    }
+    const auto step = scatter_subpath(rules, mis, si, bsdf, guides, TransportMode::Radiance, rng,
+                                      beta, rr_beta);
+    if (!step) break;
+    // PPM / lt: the non-delta part of this vertex was estimated by merging (or belongs to light
+    // tracing); only its delta lobes carry the camera path on.
+    if (tech_.camera_stops && !delta && !step->specular) break;
+    specular_path = specular_path && step->specular;
+    eta_scale *= sqr(step->eta);
     if (beta.is_black()) break;
     prev_p = si.p;
-    ray = si.spawn_ray(wi);
+    ray = si.spawn_ray(step->wi);
     if (tech_.guided ? !survives_guided_roulette(beta, rr_beta, eta_scale, depth, rng)
                      : !survives_russian_roulette(beta, eta_scale, depth, rng))
       break;

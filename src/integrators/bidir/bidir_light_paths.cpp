@@ -9,6 +9,7 @@
 
 #include "film/film.h"
 #include "integrators/bidir/bidir_core.h"
+#include "integrators/bidir/subpath_step.h"
 #include "lights/light.h"
 #include "lights/light_sampler.h"
 #include "materials/material.h"
@@ -174,34 +175,11 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
     }
     if (depth + 1 > max_depth) break;
 
-    Vec3 wi;
-    if (guides.guide(TransportMode::Importance, si.wo)) {
-      // guided: the mixture of the BSDF and the learned importance (vertex_guides.h)
-      const float u_technique = rng.next_float(), uc = rng.next_float();
-      const auto gs = sample_guided(bsdf, guides, si.wo, TransportMode::Importance, u_technique,
-                                    uc, rng.next_2d());
-      if (!gs) break;
-      wi = gs->wi;
-      scatter_update(it.rules, mis, si, bsdf, si.wo, wi, TransportMode::Importance, false, gs->pdf,
-                     guides);
-      beta *= gs->weight;
-      rr_beta *= gs->bsdf_weight;
-    } else {
-      const float uc = rng.next_float();
-      const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), TransportMode::Importance);
-      if (!bs) break;
-      wi = bs->wi;
-      const float pdf_fwd =
-          bs->pdf_is_proportional ? direction_pdf(bsdf, guides, si.wo, wi, TransportMode::Importance)
-                                  : bs->pdf;
-      scatter_update(it.rules, mis, si, bsdf, si.wo, wi, TransportMode::Importance,
-                     bs->is_specular(), pdf_fwd, guides);
-      const Rgb weight = bs->f * (bsdf.abs_cos(wi) / bs->pdf);
-      beta *= weight;
-      rr_beta *= weight;
-    }
+    const auto step = scatter_subpath(it.rules, mis, si, bsdf, guides, TransportMode::Importance,
+                                      rng, beta, rr_beta);
+    if (!step) break;
     if (beta.is_black()) break;
-    ray = si.spawn_ray(wi);
+    ray = si.spawn_ray(step->wi);
     // Russian roulette on the throughput relative to the emitted one (importance carries no
     // radiance scaling at refractions, so no eta correction); guided, on the larger of it and
     // BSDF sampling's (path_vertex.h, survives_guided_roulette).

@@ -1,0 +1,36 @@
+#include "integrators/bidir/subpath_step.h"
+
+namespace caustica::bidir {
+
+std::optional<SubpathStep> scatter_subpath(const MisRules& rules, MisSums& mis,
+                                           const SurfaceInteraction& si, const Bsdf& bsdf,
+                                           const VertexGuides& guides, TransportMode mode,
+                                           Pcg32& rng, Rgb& beta, Rgb& rr_beta) {
+  SubpathStep step;
+  if (guides.guide(mode, si.wo)) {
+    const float u_technique = rng.next_float(), uc = rng.next_float();
+    const auto gs = sample_guided(bsdf, guides, si.wo, mode, u_technique, uc, rng.next_2d());
+    if (!gs) return std::nullopt;
+    step.wi = gs->wi;
+    step.eta = gs->eta;
+    scatter_update(rules, mis, si, bsdf, si.wo, step.wi, mode, false, gs->pdf, guides);
+    beta *= gs->weight;
+    rr_beta *= gs->bsdf_weight;
+    return step;
+  }
+  const float uc = rng.next_float();
+  const auto bs = bsdf.sample(si.wo, uc, rng.next_2d(), mode);
+  if (!bs) return std::nullopt;
+  step.wi = bs->wi;
+  step.specular = bs->is_specular();
+  if (bs->is_transmission()) step.eta = bs->eta;
+  const float pdf_fwd =
+      bs->pdf_is_proportional ? direction_pdf(bsdf, guides, si.wo, step.wi, mode) : bs->pdf;
+  scatter_update(rules, mis, si, bsdf, si.wo, step.wi, mode, step.specular, pdf_fwd, guides);
+  const Rgb weight = bs->f * (bsdf.abs_cos(step.wi) / bs->pdf);
+  beta *= weight;
+  rr_beta *= weight;
+  return step;
+}
+
+}  // namespace caustica::bidir

@@ -41,7 +41,8 @@ namespace {
 // itself: a reference must not share its random numbers with the runs it judges. Rendered with
 // the runs' seed, a vcm reference repeats the first iterations of a vcm or bpt run exactly (the
 // same camera and light paths), their errors cancel, and those integrators look better than
-// they are (measured on cornell-box, 160x160, 10 s: bpt's relMSE 1.5x too low).
+// they are (measured on cornell-box 160x160, 20 s runs against 60 s vcm references: bpt's relMSE
+// 0.000148 against the seed-0 reference and 0.000733 against an independent one, 5x too low).
 constexpr uint64_t kReferenceSeedOffset = 7919;
 
 struct ReferenceOptions : SharedOptions {

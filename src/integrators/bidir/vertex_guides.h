@@ -38,6 +38,12 @@ struct VertexGuides {
   mutable const DirectionalQuadtree* guides[2][2] = {{nullptr, nullptr}, {nullptr, nullptr}};
   mutable float bsdf[2][2] = {{1, 1}, {1, 1}};
   mutable uint8_t resolved = 0;
+  // The last guide density evaluated per (mode, side) and its direction: most densities at a
+  // vertex are reverse ones at the same direction (the camera vertex's wo for its NEE, every
+  // connection and every merge; the lens direction for every pixel a light vertex splats to).
+  mutable Vec3 memo_wi[2][2];
+  mutable float memo_pdf[2][2] = {{0, 0}, {0, 0}};
+  mutable uint8_t memoized = 0;
 
   static int side_of(Vec3 n, Vec3 w) { return dot(w, n) < 0 ? 1 : 0; }
   const DirectionalQuadtree* guide(TransportMode mode, Vec3 wo) const {
@@ -51,6 +57,21 @@ struct VertexGuides {
     return bsdf[int(mode)][side_of(n, wo)];
   }
   void resolve(int side) const;  // bidir_guiding.cpp
+
+  // The solid-angle density of the guide of (mode, side of wo) at wi; only after guide() found
+  // one.
+  float guide_pdf(TransportMode mode, Vec3 wo, Vec3 wi) const {
+    const int m = int(mode), side = side_of(n, wo);
+    const uint8_t bit = uint8_t(1u << (2 * m + side));
+    if ((memoized & bit) && memo_wi[m][side].x == wi.x && memo_wi[m][side].y == wi.y &&
+        memo_wi[m][side].z == wi.z)
+      return memo_pdf[m][side];
+    const float pdf = guides[m][side]->pdf_square(direction_to_square(wi)) * kInv4Pi;
+    memo_wi[m][side] = wi;
+    memo_pdf[m][side] = pdf;
+    memoized |= bit;
+    return pdf;
+  }
 };
 
 // The density with which a subpath of `mode` at this vertex samples wi given wo.
@@ -59,8 +80,7 @@ inline float direction_pdf(const Bsdf& bsdf, const VertexGuides& g, Vec3 wo, Vec
   const DirectionalQuadtree* guide = g.guide(mode, wo);
   if (!guide) return bsdf.pdf(wo, wi, mode);
   const float a = g.bsdf_fraction(mode, wo);
-  return a * bsdf.pdf(wo, wi, mode) +
-         (1 - a) * guide->pdf_square(direction_to_square(wi)) * kInv4Pi;
+  return a * bsdf.pdf(wo, wi, mode) + (1 - a) * g.guide_pdf(mode, wo, wi);
 }
 
 // A direction sampled from the mixture of `mode` at a vertex with a guide for it.
@@ -89,7 +109,7 @@ inline std::optional<GuidedSample> sample_guided(const Bsdf& bsdf, const VertexG
     s.wi = square_to_direction(guide.sample_square(u));
   }
   const float bsdf_pdf = bsdf.pdf(wo, s.wi, mode);
-  s.pdf = a * bsdf_pdf + (1 - a) * guide.pdf_square(direction_to_square(s.wi)) * kInv4Pi;
+  s.pdf = a * bsdf_pdf + (1 - a) * g.guide_pdf(mode, wo, s.wi);
   if (!(s.pdf > 0)) return std::nullopt;
   const Rgb f_cos = bsdf.f(wo, s.wi, mode) * bsdf.abs_cos(s.wi);
   if (f_cos.is_black()) return std::nullopt;

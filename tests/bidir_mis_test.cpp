@@ -346,8 +346,8 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
     if (guiding) {
       for (const SurfaceInteraction& si : path.surfaces) {
         const VertexGuides g = guiding->at(si.p, si.ng, si.material->bsdf(si, arena));
-        guided_vertices += g.guide(TransportMode::Radiance, si.wo) &&
-                           g.guide(TransportMode::Importance, si.wo);
+        guided_vertices +=
+            g.guide(TransportMode::Radiance, si.wo) && g.guide(TransportMode::Importance, si.wo);
       }
     }
     ASSERT_NEAR(sum, 1.0, 1e-4) << c.scene << " path " << checked << " with " << weights.size()
@@ -383,31 +383,28 @@ TEST_P(BidirMisPartition, WeightsSumToOneAndMatchBruteForce) {
 
 INSTANTIATE_TEST_SUITE_P(
     Bidir, BidirMisPartition,
-    ::testing::Values(Case{"cornell", BidirAlgorithm::Vcm, MisHeuristic::Balance},
-                      Case{"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Balance},
-                      Case{"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Power},
-                      Case{"cornell-glass", BidirAlgorithm::Bpt, MisHeuristic::Balance},
-                      Case{"cornell-glass", BidirAlgorithm::Bpm, MisHeuristic::Balance},
-                      Case{"mixed-lights", BidirAlgorithm::Vcm, MisHeuristic::Balance},
-                      Case{"env-furnace", BidirAlgorithm::Vcm, MisHeuristic::Power},
-                      Case{"cornell", BidirAlgorithm::Vcm, MisHeuristic::Balance, 300},
-                      Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Balance, 700},
-                      Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Power, 5000},
-                      Case{"corners", BidirAlgorithm::Bpt, MisHeuristic::Balance, 700},
-                      // adaptive-vcm's counts: several connections per camera vertex, fewer
-                      // or more light paths than pixels, pixels that do not merge.
-                      Case{"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Balance, 256, 4},
-                      Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Balance, 2240, 2, false},
-                      Case{"mixed-lights", BidirAlgorithm::Vcm, MisHeuristic::Power, 512, 8},
-                      Case{"cornell-glass", BidirAlgorithm::Bpt, MisHeuristic::Balance, 2048, 2,
-                           false},
-                      // guided-vcm / guided-bpt: guided densities forward and reverse.
-                      Case{"cornell", BidirAlgorithm::GuidedVcm, MisHeuristic::Balance, 1024, 1,
-                           true, true},
-                      Case{"mixed-lights", BidirAlgorithm::GuidedVcm, MisHeuristic::Power, 1024,
-                           1, true, true},
-                      Case{"corners", BidirAlgorithm::GuidedBpt, MisHeuristic::Balance, 700, 2,
-                           true, true}),
+    ::testing::Values(
+        Case{"cornell", BidirAlgorithm::Vcm, MisHeuristic::Balance},
+        Case{"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Balance},
+        Case{"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Power},
+        Case{"cornell-glass", BidirAlgorithm::Bpt, MisHeuristic::Balance},
+        Case{"cornell-glass", BidirAlgorithm::Bpm, MisHeuristic::Balance},
+        Case{"mixed-lights", BidirAlgorithm::Vcm, MisHeuristic::Balance},
+        Case{"env-furnace", BidirAlgorithm::Vcm, MisHeuristic::Power},
+        Case{"cornell", BidirAlgorithm::Vcm, MisHeuristic::Balance, 300},
+        Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Balance, 700},
+        Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Power, 5000},
+        Case{"corners", BidirAlgorithm::Bpt, MisHeuristic::Balance, 700},
+        // adaptive-vcm's counts: several connections per camera vertex, fewer
+        // or more light paths than pixels, pixels that do not merge.
+        Case{"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Balance, 256, 4},
+        Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Balance, 2240, 2, false},
+        Case{"mixed-lights", BidirAlgorithm::Vcm, MisHeuristic::Power, 512, 8},
+        Case{"cornell-glass", BidirAlgorithm::Bpt, MisHeuristic::Balance, 2048, 2, false},
+        // guided-vcm / guided-bpt: guided densities forward and reverse.
+        Case{"cornell", BidirAlgorithm::GuidedVcm, MisHeuristic::Balance, 1024, 1, true, true},
+        Case{"mixed-lights", BidirAlgorithm::GuidedVcm, MisHeuristic::Power, 1024, 1, true, true},
+        Case{"corners", BidirAlgorithm::GuidedBpt, MisHeuristic::Balance, 700, 2, true, true}),
     [](const auto& info) {
       std::string n =
           std::string(info.param.scene) + "_" + std::to_string(int(info.param.algorithm)) + "_" +

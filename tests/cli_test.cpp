@@ -86,7 +86,8 @@ TEST(Cli, HelpExistsForEverySubcommand) {
 // `compare` warns when its --reference's metadata names the runs' seed.
 TEST(Cli, ReferenceDoesNotShareTheSeedOfTheRunsItJudges) {
   const fs::path d = fresh_dir("reference_seed");
-  CliRun r = run("reference cornell --time 0.2 --resolution 16x12 --integrator pt --outfile ref", d);
+  CliRun r =
+      run("reference cornell --time 0.2 --resolution 16x12 --integrator pt --outfile ref", d);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream f(d / "ref.json");
   const nlohmann::json j = nlohmann::json::parse(f);

@@ -134,8 +134,8 @@ class GuidingField {
   size_t leaf_bytes(const Leaf& l) const;
 
   GuidingSettings settings_;
-  Bounds3 bounds_;         // the scene's box (copy 0)
-  float copy_width_ = 0;   // sided: the x extent of one copy
+  Bounds3 bounds_;        // the scene's box (copy 0)
+  float copy_width_ = 0;  // sided: the x extent of one copy
   bool sided_ = false;
   std::vector<SpatialNode> nodes_;  // nodes_[0] is the root
   std::vector<Leaf> leaves_;

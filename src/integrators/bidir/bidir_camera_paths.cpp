@@ -117,8 +117,8 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
         guiding_.record_camera_vertex(pixel, depth, si.p, si.ng, si.wo, beta);
     }
 
-    const auto step = scatter_subpath(rules, mis, si, bsdf, guides, TransportMode::Radiance, rng,
-                                      beta, rr_beta);
+    const auto step =
+        scatter_subpath(rules, mis, si, bsdf, guides, TransportMode::Radiance, rng, beta, rr_beta);
     if (!step) break;
     // PPM / lt: the non-delta part of this vertex was estimated by merging (or belongs to light
     // tracing); only its delta lobes carry the camera path on.
@@ -209,8 +209,8 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
     ++acc.work.connections;
     const VertexGuides light_guides =
         tech_.guided ? guiding_.at(light_si.p, light_si.ng, light_bsdf) : VertexGuides{};
-    const TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf,
-                                                  cv.mis, light_guides, cv.guides);
+    const TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si,
+                                                  bsdf, cv.mis, light_guides, cv.guides);
     const float w = terms.weight(rules.counts());
     const Rgb value = beta * v.throughput * f_camera * f_light * (w / dist2);
     if (value.is_black()) continue;

@@ -160,8 +160,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
   // t = 1: the light vertex seen through a lens point; splat recorded in the chunk.
   void connect_to_camera(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
-                         const Bsdf& bsdf, const VertexGuides& guides, Rgb beta,
-                         const MisSums& mis, int depth, Pcg32& rng, LightChunk& chunk) const;
+                         const Bsdf& bsdf, const VertexGuides& guides, Rgb beta, const MisSums& mis,
+                         int depth, Pcg32& rng, LightChunk& chunk) const;
 
   // ---- camera subpaths ----------------------------------------------------------------------
   // The seam's per-pixel call: the camera subpath of this iteration (current_).

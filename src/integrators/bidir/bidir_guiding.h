@@ -60,9 +60,7 @@ class BidirGuiding {
   VertexGuides at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const;
 
   // Camera vertices of `pixel` are recorded this iteration (one pixel in k).
-  bool records_pixel(uint64_t pixel) const {
-    return (pixel + iteration_) % camera_stride_ == 0;
-  }
+  bool records_pixel(uint64_t pixel) const { return (pixel + iteration_) % camera_stride_ == 0; }
   // The camera subpath of `pixel` reached a non-delta vertex at p (geometric normal ng),
   // arriving along -wo with throughput beta (from estimate(): any thread).
   void record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 ng, Vec3 wo, Rgb beta) const;

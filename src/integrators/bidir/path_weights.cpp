@@ -16,8 +16,8 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
                                                 int connections, bool pixel_merges,
                                                 const BidirGuiding* guiding) {
   const bool connect = algorithm != BidirAlgorithm::Bpm;
-  const bool merge = algorithm != BidirAlgorithm::Bpt && algorithm != BidirAlgorithm::GuidedBpt &&
-                     pixel_merges;
+  const bool merge =
+      algorithm != BidirAlgorithm::Bpt && algorithm != BidirAlgorithm::GuidedBpt && pixel_merges;
   MisCounts counts;
   counts.emitter = connect ? 1.f : 0.f;
   counts.light_trace = connect ? light_paths : 0.f;
@@ -47,7 +47,8 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   }
   auto delta = [&](int i) { return bsdf[i].is_delta(); };
   std::vector<VertexGuides> guides(k);
-  for (int i = 1; guiding && i < k; ++i) guides[i] = guiding->at(x[i], path.surfaces[i - 1].ng, bsdf[i]);
+  for (int i = 1; guiding && i < k; ++i)
+    guides[i] = guiding->at(x[i], path.surfaces[i - 1].ng, bsdf[i]);
 
   // Light subpath replay: sums at x1..x(k-1), stored and reloaded as the renderer does.
   LightLeSample le;
@@ -63,10 +64,9 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
     } else {
       MisSums m = light_mis[i - 1];
       const bool specular = delta(i - 1);
-      const float pdf_fwd =
-          specular ? 1.f
-                   : direction_pdf(bsdf[i - 1], guides[i - 1], light_si[i - 1].wo, dir(i - 1, i),
-                                   TransportMode::Importance);
+      const float pdf_fwd = specular ? 1.f
+                                     : direction_pdf(bsdf[i - 1], guides[i - 1], light_si[i - 1].wo,
+                                                     dir(i - 1, i), TransportMode::Importance);
       scatter_update(rules, m, light_si[i - 1], bsdf[i - 1], light_si[i - 1].wo, dir(i - 1, i),
                      TransportMode::Importance, specular, pdf_fwd, guides[i - 1]);
       rules.hit(m, distance_squared(x[i - 1], x[i]), geometric_cos(light_si[i], dir(i, i - 1)));
@@ -88,10 +88,9 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   for (int i = k - 2; i >= 1; --i) {
     MisSums m = camera_mis[i + 1];
     const bool specular = delta(i + 1);
-    const float pdf_fwd =
-        specular ? 1.f
-                 : direction_pdf(bsdf[i + 1], guides[i + 1], camera_si[i + 1].wo, dir(i + 1, i),
-                                 TransportMode::Radiance);
+    const float pdf_fwd = specular ? 1.f
+                                   : direction_pdf(bsdf[i + 1], guides[i + 1], camera_si[i + 1].wo,
+                                                   dir(i + 1, i), TransportMode::Radiance);
     scatter_update(rules, m, camera_si[i + 1], bsdf[i + 1], camera_si[i + 1].wo, dir(i + 1, i),
                    TransportMode::Radiance, specular, pdf_fwd, guides[i + 1]);
     rules.hit(m, distance_squared(x[i + 1], x[i]), geometric_cos(camera_si[i], dir(i, i + 1)));
@@ -104,10 +103,9 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   if (connect && !light.is_delta()) {
     MisSums m = camera_mis[1];
     const bool specular = delta(1);
-    const float pdf_fwd =
-        specular ? 1.f
-                 : direction_pdf(bsdf[1], guides[1], camera_si[1].wo, to_light,
-                                 TransportMode::Radiance);
+    const float pdf_fwd = specular ? 1.f
+                                   : direction_pdf(bsdf[1], guides[1], camera_si[1].wo, to_light,
+                                                   TransportMode::Radiance);
     scatter_update(rules, m, camera_si[1], bsdf[1], camera_si[1].wo, to_light,
                    TransportMode::Radiance, specular, pdf_fwd, guides[1]);
     float w;
@@ -133,19 +131,19 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
     ls.pdf_w = light.is_delta() ? 1.f : light.pdf_li(x[1], ls.wi, x[0], ls.n_light);
     light.pdf_le(x[0], le.n, -ls.wi, &ls.pdf_emit_pos, &ls.pdf_emit_dir);
     ls.cos_at_light = light.type() == LightType::Area ? abs_dot(path.light_normal, ls.wi) : 1.f;
-    out.push_back({false, 1, k,
-                   terms_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1],
-                                    guides[1])
-                       .weight(rules.counts())});
+    out.push_back(
+        {false, 1, k,
+         terms_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1], guides[1])
+             .weight(rules.counts())});
   }
   // 2 <= s <= k - 1: connections of x(s-1) and x(s).
   for (int s = 2; connect && s <= k - 1; ++s) {
     if (delta(s - 1) || delta(s)) continue;
-    out.push_back({false, s, k + 1 - s,
-                   terms_connection(rules, light_si[s - 1], bsdf[s - 1], light_si[s - 1].wo,
-                                    stored(s - 1), camera_si[s], bsdf[s], camera_mis[s],
-                                    guides[s - 1], guides[s])
-                       .weight(rules.counts())});
+    out.push_back(
+        {false, s, k + 1 - s,
+         terms_connection(rules, light_si[s - 1], bsdf[s - 1], light_si[s - 1].wo, stored(s - 1),
+                          camera_si[s], bsdf[s], camera_mis[s], guides[s - 1], guides[s])
+             .weight(rules.counts())});
   }
   // t = 1: x(k-1) connected to the lens.
   if (connect && k >= 2 && !delta(k - 1)) {
@@ -158,11 +156,10 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   // Merges at every non-delta interior vertex.
   for (int j = 1; merge && j <= k - 1; ++j) {
     if (delta(j)) continue;
-    out.push_back(
-        {true, j + 1, k + 1 - j,
-         terms_merge(rules, light_si[j].wo, stored(j), camera_si[j], bsdf[j], camera_mis[j],
-                     guides[j])
-             .weight(rules.counts())});
+    out.push_back({true, j + 1, k + 1 - j,
+                   terms_merge(rules, light_si[j].wo, stored(j), camera_si[j], bsdf[j],
+                               camera_mis[j], guides[j])
+                       .weight(rules.counts())});
   }
   return out;
 }

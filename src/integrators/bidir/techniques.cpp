@@ -82,8 +82,9 @@ TechniqueTerms terms_connection(const MisRules& rules, const SurfaceInteraction&
       geometric_cos(light_si, dir) / dist2;
   const float camera_rev =
       direction_pdf(camera_bsdf, cg, dir, camera_si.wo, TransportMode::Importance);
-  const float light_pdf_a = direction_pdf(light_bsdf, lg, light_wo, -dir, TransportMode::Importance) *
-                            geometric_cos(camera_si, dir) / dist2;
+  const float light_pdf_a =
+      direction_pdf(light_bsdf, lg, light_wo, -dir, TransportMode::Importance) *
+      geometric_cos(camera_si, dir) / dist2;
   const float light_rev = direction_pdf(light_bsdf, lg, -dir, light_wo, TransportMode::Radiance);
   return rules.connect(light, camera, camera_pdf_a, camera_rev, light_pdf_a, light_rev);
 }
@@ -106,7 +107,8 @@ TechniqueTerms terms_merge(const MisRules& rules, Vec3 light_wo, const MisSums& 
                            const MisSums& camera, const VertexGuides& camera_guides) {
   const VertexGuides& g = camera_guides;
   const float fwd = direction_pdf(camera_bsdf, g, camera_si.wo, light_wo, TransportMode::Radiance);
-  const float rev = direction_pdf(camera_bsdf, g, light_wo, camera_si.wo, TransportMode::Importance);
+  const float rev =
+      direction_pdf(camera_bsdf, g, light_wo, camera_si.wo, TransportMode::Importance);
   return rules.merge(light, camera, fwd, rev);
 }
 

@@ -53,9 +53,7 @@ struct VertexGuides {
     return guides[int(mode)][side];
   }
   // Only after guide() of the same mode and side.
-  float bsdf_fraction(TransportMode mode, Vec3 wo) const {
-    return bsdf[int(mode)][side_of(n, wo)];
-  }
+  float bsdf_fraction(TransportMode mode, Vec3 wo) const { return bsdf[int(mode)][side_of(n, wo)]; }
   void resolve(int side) const;  // bidir_guiding.cpp
 
   // The solid-angle density of the guide of (mode, side of wo) at wi; only after guide() found
@@ -86,10 +84,10 @@ inline float direction_pdf(const Bsdf& bsdf, const VertexGuides& g, Vec3 wo, Vec
 // A direction sampled from the mixture of `mode` at a vertex with a guide for it.
 struct GuidedSample {
   Vec3 wi;
-  float pdf = 0;     // the mixture's
-  Rgb weight;        // f |cos| / pdf
-  Rgb bsdf_weight;   // f |cos| / p_bsdf: the weight had the BSDF alone been sampled (roulette)
-  float eta = 1;     // of a sampled refraction, else 1
+  float pdf = 0;    // the mixture's
+  Rgb weight;       // f |cos| / pdf
+  Rgb bsdf_weight;  // f |cos| / p_bsdf: the weight had the BSDF alone been sampled (roulette)
+  float eta = 1;    // of a sampled refraction, else 1
 };
 
 // u_technique picks the BSDF (below the BSDF fraction) or the guide; uc and u sample either.

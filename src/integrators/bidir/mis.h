@@ -85,6 +85,12 @@ class MisRules {
   bool power() const { return power_; }
   // The counts through mis(), as the weights use them.
   const MisCounts& counts() const { return counts_; }
+  // Whether any technique of a light subpath (light tracing, connection, merge) counts. Without
+  // one (adaptive-vcm rendering path tracing) the camera sums' reverse densities only ever meet
+  // counts of zero, so they need not be evaluated (reverse_pdf()).
+  bool uses_light_subpaths() const {
+    return counts_.light_trace > 0 || counts_.connect > 0 || counts_.merge > 0;
+  }
   // The same rules in a pixel that merges or not (merge count 0).
   MisRules with_merging(bool merge) const;
 

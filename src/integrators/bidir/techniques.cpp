@@ -34,7 +34,11 @@ MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf
 void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteraction& si,
                     const Bsdf& bsdf, Vec3 wo, Vec3 wi, TransportMode mode, bool specular,
                     float pdf_fwd, const VertexGuides& guides) {
-  const float pdf_rev = specular ? pdf_fwd : direction_pdf(bsdf, guides, wi, wo, !mode);
+  // Without light-subpath techniques the reverse density meets only counts of zero: the weights
+  // are the same bit for bit without evaluating it (a random walk for a layered BSDF).
+  const float pdf_rev = specular                       ? pdf_fwd
+                        : !rules.uses_light_subpaths() ? 0.f
+                                                       : direction_pdf(bsdf, guides, wi, wo, !mode);
   rules.scatter(mis, geometric_cos(si, wi), pdf_fwd, pdf_rev, specular);
 }
 
@@ -58,7 +62,9 @@ TechniqueTerms terms_next_event(const MisRules& rules, const Light& light, float
                                 const VertexGuides& guides) {
   const float bsdf_fwd =
       light.is_delta() ? 0.f : direction_pdf(bsdf, guides, si.wo, ls.wi, TransportMode::Radiance);
-  const float bsdf_rev = direction_pdf(bsdf, guides, ls.wi, si.wo, TransportMode::Importance);
+  const float bsdf_rev = rules.uses_light_subpaths()
+                             ? direction_pdf(bsdf, guides, ls.wi, si.wo, TransportMode::Importance)
+                             : 0.f;
   // Delta positions have area density 1: in solid angle at si that is dist^2.
   const float direct_w =
       pmf * (light.type() == LightType::DeltaPosition ? ls.distance * ls.distance : ls.pdf_w);

@@ -387,6 +387,20 @@ TEST(GuidedPathTracer, RenderingTrainsTheField) {
   integrator.report(stats);
   EXPECT_EQ(stats["guiding"]["training_passes_completed"], 3);
   EXPECT_GT(stats["guiding"]["guiding_bytes"].get<size_t>(), 0u);
+  // The report's views of the learned field (guide_views.h): 9 pixels; where something was
+  // learned, a density over the sphere that integrates to about 1 (midpoints of 32 x 16 cells).
+  const nlohmann::json& views = stats["guiding"]["views"];
+  ASSERT_EQ(views["views"].size(), 9u);
+  int learned = 0;
+  for (const auto& v : views["views"]) {
+    if (!v.contains("density")) continue;
+    ++learned;
+    double integral = 0;
+    for (const auto& x : v["density"]) integral += x.get<double>();
+    integral *= 4 * kPi / double(views["width"].get<int>() * views["height"].get<int>());
+    EXPECT_NEAR(integral, 1.0, 0.15) << v["pixel"];
+  }
+  EXPECT_GE(learned, 5);
 }
 
 // The registry's determinism oracle renders 3 iterations (one splat feeds the sampling); here

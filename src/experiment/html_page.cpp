@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "experiment/adaptive_view.h"
+#include "experiment/guide_view.h"
 
 namespace caustica {
 
@@ -188,7 +189,7 @@ std::string comparison_html(const ComparisonResult& result, const nlohmann::json
        "final relMSE "
        "(read off pt's curve; beyond it relMSE ~ 1/t), divided by this integrator's time.</p>\n"
     << "<p class=\"hint\">Reference: " << escape(result.reference_description) << "</p>\n"
-    << adaptive_choices_html(result)
+    << adaptive_choices_html(result) << guide_views_html(result)
     << "<pre id=\"selftest\"></pre>\n<script type=\"application/json\" id=\"views\">"
     << views.dump() << "</script>\n<script>" << kScript << "</script>\n</body></html>\n";
   return o.str();

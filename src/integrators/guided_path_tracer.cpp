@@ -6,6 +6,7 @@
 
 #include "core/math.h"
 #include "film/film.h"
+#include "integrators/guide_views.h"
 #include "integrators/path_vertex.h"
 #include "lights/light.h"
 #include "lights/light_sampler.h"
@@ -229,6 +230,12 @@ void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, 
   recorded_ += merged_.size();
 }
 
+void GuidedPathTracer::finish(const Scene& scene, Film& film) {
+  CameraPathIntegrator::finish(scene, film);
+  views_ = guide_views(scene,
+                       [&](Vec3 p, int side) { return &field_.sampling(field_.leaf_at(p, side)); });
+}
+
 Image GuidedPathTracer::image(const Film& film) const {
   if (!settings_.guiding.inverse_variance) return film.image();
   Image combined = passes_.image();
@@ -327,6 +334,7 @@ void GuidedPathTracer::report(nlohmann::json& stats) const {
   for (const InverseVarianceCombiner::Pass& p : passes_.passes())
     passes.push_back({{"spp", p.samples}, {"variance", p.variance}});
   g["passes"] = passes;
+  if (!views_.is_null()) g["views"] = views_;
   stats["guiding"] = g;
 }
 

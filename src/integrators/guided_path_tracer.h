@@ -48,6 +48,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "guiding/guiding_field.h"
@@ -65,6 +66,7 @@ class GuidedPathTracer final : public CameraPathIntegrator {
   void prepare(const Scene& scene, Film& film) override;
   void render_iteration(const Scene& scene, uint32_t iteration, Film& film) override;
   Image image(const Film& film) const override;
+  void finish(const Scene& scene, Film& film) override;
   void report(nlohmann::json& stats) const override;
 
   // The training pass of an iteration: floor(log2(iteration + 1)).
@@ -85,6 +87,7 @@ class GuidedPathTracer final : public CameraPathIntegrator {
   // Path vertices per spatial leaf, per thread (added to the field after each iteration).
   mutable tbb::enumerable_thread_specific<std::vector<uint32_t>> vertex_counts_;
   std::vector<GuidingRecord> merged_;
+  nlohmann::json views_;  // what was learned at a few pixels (guide_views.h), by finish()
   // Written by estimate(): one writer per pixel at a time.
   mutable InverseVarianceCombiner passes_;
 };

@@ -6,6 +6,7 @@
 #include <bit>
 
 #include "core/rng.h"
+#include "integrators/guide_views.h"
 #include "scene/scene.h"
 
 namespace caustica::bidir {
@@ -130,6 +131,16 @@ void BidirGuiding::end_iteration(const Scene& scene,
   learn(importance_, merged_, float(camera_stride_));
 }
 
+void BidirGuiding::make_views(const Scene& scene) {
+  views_ = {{"radiance", guide_views(scene,
+                                     [&](Vec3 p, int side) {
+                                       return &radiance_.sampling(radiance_.leaf_at(p, side));
+                                     })},
+            {"importance", guide_views(scene, [&](Vec3 p, int side) {
+               return &importance_.sampling(importance_.leaf_at(p, side));
+             })}};
+}
+
 void BidirGuiding::report(nlohmann::json& stats) const {
   nlohmann::json g;
   g["training_passes_completed"] = pass_;
@@ -142,6 +153,7 @@ void BidirGuiding::report(nlohmann::json& stats) const {
   g["radiance_records"] = radiance_records_;
   g["importance_records"] = importance_records_;
   g["bsdf_fraction"] = radiance_.settings().bsdf_fraction;
+  if (!views_.is_null()) g["views"] = views_;
   stats["guiding"] = g;
 }
 

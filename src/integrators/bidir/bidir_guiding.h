@@ -68,6 +68,9 @@ class BidirGuiding {
   // scene) and camera records.
   void end_iteration(const Scene& scene, const std::vector<LightVertex>& light_vertices);
 
+  // What was learned at a few pixels (guide_views.h): the radiance camera subpaths see and the
+  // importance light subpaths arriving there would be guided by. Kept for report().
+  void make_views(const Scene& scene);
   void report(nlohmann::json& stats) const;
 
  private:
@@ -85,6 +88,7 @@ class BidirGuiding {
   uint64_t radiance_records_ = 0, importance_records_ = 0;
   mutable tbb::enumerable_thread_specific<std::vector<GuidingRecord>> camera_records_;
   std::vector<GuidingRecord> merged_;
+  nlohmann::json views_;
 };
 
 }  // namespace caustica::bidir

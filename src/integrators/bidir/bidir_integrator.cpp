@@ -149,7 +149,8 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   seconds_total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-void BidirIntegrator::finish(const Scene&, Film& film) {
+void BidirIntegrator::finish(const Scene& scene, Film& film) {
+  if (tech_.guided) guiding_.make_views(scene);
   if (techniques_.enabled())
     technique_files_ = techniques_.write(settings_.bidir.techniques_dir, film.iterations());
 }

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <mutex>
 
 #include "integrators/bidir/bidir_core.h"
 #include "integrators/bidir/subpath_step.h"
@@ -39,11 +38,23 @@ Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pc
 }
 
 void BidirIntegrator::add_work(const ProbeWork& w) const {
-  std::lock_guard<std::mutex> lock(probe_mutex_);
-  add_counts(probe_, w);  // a pixel's work has no light paths or light vertices
-  probe_.camera_seconds += w.camera_seconds;
-  probe_.connect_seconds += w.connect_seconds;
-  probe_.merge_seconds += w.merge_seconds;
+  ProbeWork& mine = pixel_work_.local();
+  add_counts(mine, w);  // a pixel's work has no light paths or light vertices
+  mine.camera_seconds += w.camera_seconds;
+  mine.connect_seconds += w.connect_seconds;
+  mine.merge_seconds += w.merge_seconds;
+}
+
+void BidirIntegrator::collect_work() {
+  // The counts are integers held in doubles, exact in any order; the seconds (measured costs
+  // only) are not reproducible anyway.
+  for (ProbeWork& w : pixel_work_) {
+    add_counts(probe_, w);
+    probe_.camera_seconds += w.camera_seconds;
+    probe_.connect_seconds += w.connect_seconds;
+    probe_.merge_seconds += w.merge_seconds;
+    w = {};
+  }
 }
 
 void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,

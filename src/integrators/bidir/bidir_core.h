@@ -4,8 +4,9 @@
 // light-tracing splats) and bidir_camera_paths.cpp (camera subpaths: NEE, connections, merging).
 #pragma once
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include <chrono>
-#include <mutex>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -168,8 +169,10 @@ class BidirIntegrator final : public CameraPathIntegrator {
   Rgb estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng, ScratchArena& arena,
                uint64_t* nonfinite) const override;
 
-  // A pixel's work, into this iteration's (probe_).
+  // A pixel's work, into its thread's (pixel_work_: no lock per pixel); collect_work() adds
+  // them to this iteration's (probe_) after the camera pass.
   void add_work(const ProbeWork& w) const;
+  void collect_work();
 
   void camera_path(const Scene& scene, const Iteration& it, const CameraSample& sample, Pcg32& rng,
                    PixelAccumulator& acc, ScratchArena& arena) const;
@@ -260,8 +263,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
   // adaptive-vcm: the plan, and the work of the current probe iteration.
   mutable AdaptivePlan plan_;
-  mutable ProbeWork probe_;  // this iteration's work
-  mutable std::mutex probe_mutex_;
+  ProbeWork probe_;  // this iteration's work
+  mutable tbb::enumerable_thread_specific<ProbeWork> pixel_work_;
 };
 
 }  // namespace caustica::bidir

@@ -132,6 +132,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   current_ = it;
   const auto camera_start = std::chrono::steady_clock::now();
   trace_camera_paths(scene, iteration, film);
+  collect_work();
   camera_seconds_total_ += seconds_since(camera_start);
   if (tech_.guided) guiding_.end_iteration(scene, vertices_);
   probe_.light_vertices = double(vertices_.size());

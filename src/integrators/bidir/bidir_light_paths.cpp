@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 
 #include "film/film.h"
 #include "integrators/bidir/bidir_core.h"

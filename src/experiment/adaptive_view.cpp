@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "experiment/svg_grid.h"
+
 namespace caustica {
 
 namespace {
@@ -18,19 +20,9 @@ std::string mask_svg(const nlohmann::json& mask) {
   const int w = mask["width"].get<int>(), h = mask["height"].get<int>();
   const auto& fraction = mask["fraction"];
   if (w <= 0 || h <= 0 || fraction.size() != size_t(w) * size_t(h)) return "";
-  const double cell = std::max(1.0, 384.0 / w);
-  std::ostringstream o;
-  o << "<svg class=\"mergemask\" xmlns=\"http://www.w3.org/2000/svg\" width=\"" << int(cell * w)
-    << "\" height=\"" << int(cell * h) << "\" shape-rendering=\"crispEdges\">";
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const int g = int(255.0 * fraction[size_t(y) * w + x].get<double>() + 0.5);
-      o << "<rect x=\"" << num(x * cell, "%.1f") << "\" y=\"" << num(y * cell, "%.1f")
-        << "\" width=\"" << num(cell, "%.1f") << "\" height=\"" << num(cell, "%.1f")
-        << "\" fill=\"rgb(" << g << "," << g << "," << g << ")\"/>";
-    }
-  o << "</svg>";
-  return o.str();
+  std::vector<double> grey(fraction.size());
+  for (size_t i = 0; i < grey.size(); ++i) grey[i] = fraction[i].get<double>();
+  return grey_grid_svg(grey, w, h, std::max(1.0, 384.0 / w), "mergemask");
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "experiment/svg_grid.h"
+
 namespace caustica {
 
 namespace {
@@ -16,19 +18,10 @@ std::string density_svg(const nlohmann::json& view, int w, int h) {
   double peak = 0;
   for (const auto& x : d) peak = std::max(peak, x.get<double>());
   if (!(peak > 0)) return "";
-  constexpr int kCell = 4;
-  std::ostringstream o;
-  o << "<svg class=\"guideview\" xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w * kCell
-    << "\" height=\"" << h * kCell << "\" shape-rendering=\"crispEdges\">";
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const double v = std::sqrt(std::max(0.0, d[size_t(y) * w + x].get<double>()) / peak);
-      const int g = int(255.0 * v + 0.5);
-      o << "<rect x=\"" << x * kCell << "\" y=\"" << y * kCell << "\" width=\"" << kCell
-        << "\" height=\"" << kCell << "\" fill=\"rgb(" << g << "," << g << "," << g << ")\"/>";
-    }
-  o << "</svg>";
-  return o.str();
+  std::vector<double> grey(d.size());
+  for (size_t i = 0; i < grey.size(); ++i)
+    grey[i] = std::sqrt(std::max(0.0, d[i].get<double>()) / peak);
+  return grey_grid_svg(grey, w, h, 4.0, "guideview");
 }
 
 std::string grid_html(const nlohmann::json& views) {

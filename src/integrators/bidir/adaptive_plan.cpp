@@ -23,6 +23,11 @@ namespace {
 // machine and for every thread count.
 struct CostModel {
   double camera_vertex = 0.75;  // trace, BSDF, NEE with its shadow ray
+  // A camera vertex of a path-tracing iteration, which pt's own estimator renders (no MIS sums
+  // for other techniques): fitted so that the predicted bpt / pt cost ratio matches the
+  // measured one (1 thread, 160 px wide, 16 spp, 2026-11-30: door-ajar 5.3, cornell-box 4.1,
+  // veach-bidir 5.0, mis-plates 1.75, coffee 2.7; at 0.75 the model predicted 1.25x less).
+  double path_tracing_vertex = 0.6;
   double light_vertex = 1.1;    // trace, BSDF, store, connect to the lens
   double connection = 0.6;      // one light vertex connected to one camera vertex
   double merge_query = 0.18;    // one range query
@@ -36,9 +41,8 @@ constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relat
 constexpr int kFirstProbes = 2;
 // Path tracing is kept unless another configuration's predicted relVar x time is lower by more
 // than this factor. The cost model has no term for the per-iteration costs of light paths (their
-// pipeline, the splats) and prices a path-tracing iteration as it was before reverse densities
-// were skipped there, and the predicted variances carry a few percent of noise: on mis-plates a
-// quarter of the light paths won by 0.25% of the score while `pt` was 1.09x (20 s) and 1.15x
+// pipeline, the splats), and the predicted variances carry a few percent of noise: on mis-plates
+// a quarter of the light paths won by 0.25% of the score while `pt` was 1.09x (20 s) and 1.15x
 // (60 s) better. The margin changes no choice where a configuration is predicted 5% better.
 constexpr double kPathTracingMargin = 1.05;
 
@@ -51,6 +55,8 @@ CostModel costs_of(const ProbeWork& w, bool measured) {
   };
   const double own_camera = w.camera_seconds - w.connect_seconds - w.merge_seconds;
   t.camera_vertex = per(own_camera, w.camera_vertices, t.camera_vertex);
+  // Probes run the core only: pt's vertex is priced at the model's ratio to the core's.
+  t.path_tracing_vertex = t.camera_vertex * (CostModel{}.path_tracing_vertex / CostModel{}.camera_vertex);
   t.light_vertex = per(w.light_seconds, w.light_vertices, t.light_vertex);
   t.connection = per(w.connect_seconds, w.connections, t.connection);
   // Queries and photons share one clock: split it in the model's proportion.
@@ -92,11 +98,10 @@ struct PixelWork {
 };
 
 double base_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
-  double cost = w.camera_vertices * t.camera_vertex;
-  if (c.light_path_factor > 0)
-    cost += c.light_path_factor * w.light_vertices_per_path * t.light_vertex +
-            c.connections * w.connections * t.connection;
-  return cost;
+  if (c.light_path_factor == 0) return w.camera_vertices * t.path_tracing_vertex;
+  return w.camera_vertices * t.camera_vertex +
+         c.light_path_factor * w.light_vertices_per_path * t.light_vertex +
+         c.connections * w.connections * t.connection;
 }
 
 // Photon density grows with the light paths: photons per query scale with the factor.
@@ -336,6 +341,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
        {"merge_fraction", double(std::count(best_mask.begin(), best_mask.end(), 1)) / pixels},
        {"costs_us",
         {{"camera_vertex", t.camera_vertex},
+         {"path_tracing_vertex", t.path_tracing_vertex},
          {"light_vertex", t.light_vertex},
          {"connection", t.connection},
          {"merge_query", t.merge_query},

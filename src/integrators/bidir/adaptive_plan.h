@@ -25,6 +25,9 @@
 // is winsorised at its 99.5th percentile over the pixels (a shared firefly must not decide) and
 // pooled over 7 x 7 neighbours before the per-pixel merge decision (a handful of samples per
 // pixel would otherwise decide by luck).
+// Iterations that choose path tracing (and are not probes) are rendered by pt's own estimator
+// (path_tracer.h, power heuristic unless --mis says otherwise), cheaper than the core's camera
+// subpaths; the cost model prices their camera vertices separately.
 // Every iteration, probe or not, is an unbiased (consistent, when merging) estimate of the
 // same image, and the film averages them. Deterministic at fixed spp and seed for any thread
 // count unless measured costs are asked for; one process only (learns while rendering).

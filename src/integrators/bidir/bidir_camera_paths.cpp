@@ -16,6 +16,8 @@ namespace caustica::bidir {
 
 Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng,
                               ScratchArena& arena, uint64_t* nonfinite) const {
+  if (path_tracer_ && current_.plan.light_paths == 0 && !current_.plan.probe)
+    return path_tracer_->radiance(scene, sample.ray, rng, arena);
   PixelAccumulator acc;
   acc.pixel = sample.pixel;
   acc.filter_weight = sample.filter_weight;

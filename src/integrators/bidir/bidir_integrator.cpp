@@ -80,6 +80,8 @@ void BidirIntegrator::prepare(const Scene& scene, Film& film) {
   if (tech_.adaptive)
     plan_ = AdaptivePlan(film.width(), film.height(), settings_.bidir.measured_costs,
                          settings_.bidir.probe_every_iteration);
+  if (tech_.adaptive && !techniques_.enabled())
+    path_tracer_ = std::make_unique<PathTracer>(settings_);
 }
 
 void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, Film& film) {
@@ -112,6 +114,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   probe_ = {};
   probe_.light_paths = double(n);
   if (it.plan.probe) plan_.begin_probe(it.radius);
+  if (path_tracer_ && n == 0 && !it.plan.probe) ++path_tracing_iterations_;
   // Before this iteration adds anything: the film adds estimates to its totals as they come.
   const std::vector<float> means_before = it.plan.probe ? pixel_means(film) : std::vector<float>();
 
@@ -157,7 +160,10 @@ void BidirIntegrator::finish(const Scene& scene, Film& film) {
 }
 
 void BidirIntegrator::report(nlohmann::json& stats) const {
-  if (tech_.adaptive) plan_.report(stats);
+  if (tech_.adaptive) {
+    plan_.report(stats);
+    stats["adaptive"]["path_tracer_iterations"] = path_tracing_iterations_;
+  }
   if (tech_.guided) guiding_.report(stats);
   nlohmann::json b;
   b["algorithm"] = name();
@@ -177,8 +183,10 @@ void BidirIntegrator::report(nlohmann::json& stats) const {
   b["light_paths_ms_per_iteration"] = iterations_ ? 1e3 * light_seconds_total_ / iterations_ : 0.0;
   b["camera_paths_ms_per_iteration"] =
       iterations_ ? 1e3 * camera_seconds_total_ / iterations_ : 0.0;
-  // What an iteration did on average: the counts the cost model of adaptive-vcm prices.
-  const double per = iterations_ ? 1.0 / iterations_ : 0.0;
+  // What an iteration of the core did on average: the counts the cost model of adaptive-vcm
+  // prices (adaptive-vcm's iterations rendered by pt's estimator are not counted).
+  const uint32_t core_iterations = iterations_ - path_tracing_iterations_;
+  const double per = core_iterations ? 1.0 / core_iterations : 0.0;
   b["work_per_iteration"] = {
       {"light_paths", work_total_.light_paths * per},
       {"light_vertices", work_total_.light_vertices * per},

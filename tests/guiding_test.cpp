@@ -9,10 +9,12 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <tuple>
 
 #include "chi2.h"
 #include "core/math.h"
 #include "guiding/guiding_field.h"
+#include "guiding/training_schedule.h"
 #include "image/inverse_variance.h"
 #include "integrators/guided_path_tracer.h"
 #include "io/builtin_scenes.h"
@@ -361,11 +363,52 @@ TEST(Guiding, InverseVarianceCombinationWeightsPasses) {
   EXPECT_NEAR(passes[2].variance, 4.0, 1e-9);
 }
 
-TEST(GuidedPathTracer, TrainingPassesDoubleInLength) {
-  const int expected[] = {0, 1, 1, 2, 2, 2, 2, 3, 3};
-  for (uint32_t i = 0; i < 9; ++i) EXPECT_EQ(GuidedPathTracer::training_pass(i), expected[i]);
-  EXPECT_EQ(GuidedPathTracer::training_pass(14), 3);
-  EXPECT_EQ(GuidedPathTracer::training_pass(15), 4);
+// Without a budget, passes double forever: iteration i is in pass floor(log2(i + 1)).
+TEST(TrainingSchedule, PassesDoubleInLength) {
+  TrainingSchedule s;
+  const int expected[] = {0, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 3, 3, 3, 3, 4};
+  for (uint32_t i = 0; i < 16; ++i) {
+    if (s.starts_pass(i, 0.0)) s.end_pass(1.0 / double(i));
+    EXPECT_EQ(s.pass(), expected[i]) << i;
+    EXPECT_TRUE(s.learning());
+  }
+}
+
+// A sample budget: the last pass takes the rest rather than leaving a sliver (64 spp: 1 + 2 +
+// 4 + 8 + 16 training, then 33 in the final pass), and records nothing.
+TEST(TrainingSchedule, LastPassTakesTheRestOfASampleBudget) {
+  for (auto [spp, final_from, passes] :
+       {std::tuple{64, 31, 5}, std::tuple{16, 7, 3}, std::tuple{2, 1, 1}, std::tuple{1, -1, 0}}) {
+    TrainingSchedule s(spp, 0);
+    for (uint32_t i = 0; i < uint32_t(spp); ++i)
+      if (s.starts_pass(i, 0.0)) s.end_pass(1.0 / sqr(double(i)));  // falls: keeps learning
+    EXPECT_EQ(s.final_from(), final_from) << spp;
+    EXPECT_EQ(s.pass(), passes) << spp;
+    if (final_from >= 0) {
+      EXPECT_STREQ(s.reason(), "budget");
+    }
+  }
+}
+
+// Training stops when the predicted final variance V^_k = V_k B_k / R_k rises (Müller 2017, sec.
+// 5.2): with 1000 spp and passes whose per-sample variance stops falling after pass 2, pass 3
+// (the first with V^_3 > V^_2) is the last to learn and pass 4 is final.
+TEST(TrainingSchedule, StopsLearningWhenItStopsPaying) {
+  TrainingSchedule s(1000, 0);
+  // Per-sample variance of passes 0.. (pass 0 has no estimate): 4 (pass 1), 2, 2, 2, ...
+  const double per_sample[] = {-1, 4, 2, 2, 2, 2, 2, 2, 2, 2};
+  for (uint32_t i = 0; i < 1000; ++i)
+    if (s.starts_pass(i, 0.0)) {
+      const int k = s.pass() - 1;  // the pass that ended
+      s.end_pass(per_sample[k] < 0 ? -1 : per_sample[k] / double(1u << k));
+    }
+  EXPECT_STREQ(s.reason(), "variance");
+  EXPECT_EQ(s.final_from(), 15);  // pass 4 starts at iteration 15
+  const auto& v = s.predicted_final_variances();
+  ASSERT_EQ(v.size(), 4u);
+  EXPECT_LT(v[0], 0);
+  EXPECT_LT(v[2], v[1]);
+  EXPECT_GT(v[3], v[2]);
 }
 
 // Rendering trains the field: after 15 iterations (passes 0..3) it has learned radiance and

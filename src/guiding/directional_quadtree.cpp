@@ -129,6 +129,11 @@ void DirectionalQuadtree::propagate() {
   for (size_t i = nodes_.size(); i-- > 0;)
     for (int q = 0; q < 4; ++q)
       if (const uint32_t c = nodes_[i].child[q]) nodes_[i].energy[q] = float(sum(nodes_[c].energy));
+  factors_.clear();  // factor() computes while the vector is shorter than nodes_
+  std::vector<std::array<float, 4>> factors(nodes_.size());
+  for (uint32_t i = 0; i < nodes_.size(); ++i)
+    for (int q = 0; q < 4; ++q) factors[i][q] = factor(i, q);
+  factors_ = std::move(factors);
 }
 
 // Each level multiplies the density by 4 (a quadrant has a quarter of its parent's area) times
@@ -138,11 +143,8 @@ float DirectionalQuadtree::pdf_square(Vec2 p) const {
   float pdf = 1;
   uint32_t node = 0;
   for (;;) {
-    const std::array<float, 4>& e = nodes_[node].energy;
-    const float node_total = (e[0] + e[1]) + (e[2] + e[3]);
-    if (!(node_total > 0)) return 0;
     const int ix = x >= 0.5, iy = y >= 0.5, q = ix + 2 * iy;
-    pdf *= 4 * e[q] / node_total;
+    pdf *= factor(node, q);
     x = 2 * x - ix;
     y = 2 * y - iy;
     const uint32_t child = nodes_[node].child[q];
@@ -190,7 +192,7 @@ Vec2 DirectionalQuadtree::sample_square(Vec2 u, float* pdf) const {
     size *= 0.5;
     ox += ix * size;
     oy += iy * size;
-    density *= 4 * e[ix + 2 * iy] / ((e[0] + e[1]) + (e[2] + e[3]));
+    density *= factor(node, ix + 2 * iy);
     const uint32_t child = nodes_[node].child[ix + 2 * iy];
     if (!child) break;
     node = child;

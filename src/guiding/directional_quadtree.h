@@ -49,7 +49,10 @@ class DirectionalQuadtree {
   // (reflected back into the square in u, wrapped in v). Its expectation over u in [0, 1)^2 is
   // record_filtered(); it costs two descents instead of a walk over every overlapped quadrant.
   void record_jittered(Vec2 p, double value, Vec2 u);
-  // Recomputes inner nodes' energies from the leaves (bottom up).
+  // Recomputes inner nodes' energies from the leaves (bottom up), and each node's density
+  // factors (4 e_q / total per quadrant), which pdf_square() and sample_square() multiply along
+  // the descent instead of dividing at every level (record() after it leaves them stale until
+  // the next propagate(); a sampling distribution is no longer recorded into).
   void propagate();
 
   // Density on the unit square at p; 0 everywhere if total() == 0. Solid angle: pdf / (4 pi).
@@ -69,10 +72,16 @@ class DirectionalQuadtree {
   DirectionalQuadtree refined(double rho, int max_depth, size_t* node_budget) const;
 
   size_t node_count() const { return nodes_.size(); }
-  size_t bytes() const { return nodes_.capacity() * sizeof(Node); }
-  void shrink_to_fit() { nodes_.shrink_to_fit(); }
+  size_t bytes() const {
+    return nodes_.capacity() * sizeof(Node) + factors_.capacity() * sizeof(factors_[0]);
+  }
+  void shrink_to_fit() {
+    nodes_.shrink_to_fit();
+    factors_.shrink_to_fit();
+  }
   int depth() const;
-  static constexpr size_t kNodeBytes = sizeof(Node);
+  // Per node, sampled or recorded: the node and its density factors.
+  static constexpr size_t kNodeBytes = sizeof(Node) + sizeof(std::array<float, 4>);
 
  private:
   // Adds density * (overlap area) of the box [x0, x1) x [y0, y1) to the leaf quadrants under
@@ -82,7 +91,19 @@ class DirectionalQuadtree {
   // Side of the leaf quadrant holding p.
   double leaf_size(Vec2 p) const;
 
+  // Quadrant q of node n multiplies the density by factor(n, q) = 4 e_q / (sum of e) (0 where
+  // the node has no energy): from
+  // factors_ when propagate() filled it, else computed (the same float expression either way,
+  // so that sample_square() and pdf_square() agree bit for bit).
+  float factor(uint32_t node, int q) const {
+    if (factors_.size() == nodes_.size()) return factors_[node][q];
+    const std::array<float, 4>& e = nodes_[node].energy;
+    const float total = (e[0] + e[1]) + (e[2] + e[3]);
+    return total > 0 ? 4 * e[q] / total : 0.f;  // no energy below: density 0
+  }
+
   std::vector<Node> nodes_;  // nodes_[0] is the root; children come after their parents
+  std::vector<std::array<float, 4>> factors_;
 };
 
 }  // namespace caustica

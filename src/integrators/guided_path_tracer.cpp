@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "core/math.h"
 #include "film/film.h"
@@ -192,25 +193,28 @@ class PathLearning {
 
 }  // namespace
 
-int GuidedPathTracer::training_pass(uint32_t iteration) {
-  return std::bit_width(uint64_t(iteration) + 1) - 1;
-}
-
 void GuidedPathTracer::prepare(const Scene& scene, Film& film) {
   CameraPathIntegrator::prepare(scene, film);
   field_ = GuidingField(scene.bounds(), settings_.guiding, /*sided=*/true);
   passes_ = InverseVarianceCombiner(scene.camera().width(), scene.camera().height());
-  pass_ = 0;
+  schedule_ = TrainingSchedule(budget_spp(), budget_seconds());
+  start_ = std::chrono::steady_clock::now();
   recorded_ = 0;
   peak_record_bytes_ = 0;
 }
 
 void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, Film& film) {
-  const int pass = training_pass(iteration);
-  if (pass > pass_) {
-    field_.end_pass(pass_);
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  if (schedule_.starts_pass(iteration, elapsed)) {
+    schedule_.end_pass(passes_.passes().back().variance);
+    field_.end_pass(schedule_.pass() - 1);
     passes_.end_pass();
-    pass_ = pass;
+  }
+  if (!schedule_.learning()) {  // the final pass: sampling only
+    trace_camera_paths(scene, iteration, film);
+    passes_.end_iteration();
+    return;
   }
   for (std::vector<GuidingRecord>& r : records_) r.clear();
   trace_camera_paths(scene, iteration, film);
@@ -245,9 +249,15 @@ Image GuidedPathTracer::image(const Film& film) const {
 Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng,
                                ScratchArena& arena, uint64_t*) const {
   const MisHeuristic heuristic = settings_.mis_or(MisHeuristic::Power);
-  PathLearning learning(arena, settings_.max_depth, sample.pixel, records_.local());
-  std::vector<uint32_t>& vertex_counts = vertex_counts_.local();
-  if (vertex_counts.size() != field_.leaf_count()) vertex_counts.assign(field_.leaf_count(), 0);
+  const bool learn = schedule_.learning();
+  // The final pass learns nothing: no per-thread buffers are looked up (a hash per pixel).
+  std::optional<PathLearning> learning;
+  std::vector<uint32_t>* vertex_counts = nullptr;
+  if (learn) {
+    learning.emplace(arena, settings_.max_depth, sample.pixel, records_.local());
+    vertex_counts = &vertex_counts_.local();
+    if (vertex_counts->size() != field_.leaf_count()) vertex_counts->assign(field_.leaf_count(), 0);
+  }
   Rgb L(0.f), beta(1.f);
   Rgb rr_beta(1.f);  // the throughput of BSDF sampling, for Russian roulette
   Ray ray = sample.ray;
@@ -259,7 +269,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
 
   auto add = [&](Rgb c) {
     L += c;
-    learning.contribute(c);
+    if (learn) learning->contribute(c);
   };
   auto add_emission = [&](const SurfaceInteraction* hit) {
     add_emission_seen(scene, ray, hit, depth == 0 || specular_bounce, prev_pdf, prev_p, heuristic,
@@ -273,7 +283,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     if (depth++ == settings_.max_depth) break;
 
     const Vec3 wo = si.wo;
-    const Mixture mix = mixture_at(field_, settings_.guiding.filter, si, bsdf, rng);
+    const Mixture mix = mixture_at(field_, learn && settings_.guiding.filter, si, bsdf, rng);
     // Next event estimation asks for the mixture density toward the light (not for a delta
     // light); what it evaluated is kept for the record.
     DirectionPdfs nee_pdfs;
@@ -290,9 +300,9 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     add(direct_light_mis(
         scene, si, bsdf, beta, u_light, u, mixture_pdf,
         [&](float a, float b) { return mis_weight(heuristic, a, b); }, &seen));
-    if (mix.guidable && !seen.Li.is_black())
-      learning.add_next_event(mix, seen,
-                              nee_evaluated ? nee_pdfs : mix.evaluate(bsdf, wo, seen.wi));
+    if (learn && mix.guidable && !seen.Li.is_black())
+      learning->add_next_event(mix, seen,
+                               nee_evaluated ? nee_pdfs : mix.evaluate(bsdf, wo, seen.wi));
 
     const float uc = rng.next_float();
     const Vec2 u_dir = rng.next_2d();
@@ -301,9 +311,9 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     if (!s) break;
     eta_scale *= s->eta2;
     beta *= s->weight;
-    if (mix.guidable) {
-      ++vertex_counts[mix.record_leaf];
-      learning.add_vertex(mix, *s, beta);
+    if (learn && mix.guidable) {
+      ++(*vertex_counts)[mix.record_leaf];
+      learning->add_vertex(mix, *s, beta);
     }
     prev_pdf = s->pdf;
     specular_bounce = s->specular;
@@ -313,14 +323,17 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     rr_beta *= s->bsdf_weight;
     if (!survives_guided_roulette(beta, rr_beta, eta_scale, depth, rng)) break;
   }
-  learning.finish();
+  if (learn) learning->finish();
   passes_.add(sample.pixel, L * sample.filter_weight);
   return L;
 }
 
 void GuidedPathTracer::report(nlohmann::json& stats) const {
   nlohmann::json g;
-  g["training_passes_completed"] = pass_;
+  g["training_passes_completed"] = schedule_.pass();
+  g["final_pass_from_iteration"] = schedule_.final_from();
+  g["final_pass_reason"] = schedule_.reason();
+  g["predicted_final_variances"] = schedule_.predicted_final_variances();
   g["spatial_leaves"] = field_.leaf_count();
   g["spatial_nodes"] = field_.spatial_node_count();
   g["quadtree_nodes"] = field_.quadtree_node_count();

@@ -28,11 +28,13 @@
 // would have had (throughput roulette ends guided paths toward bright light for their small
 // weight, which is exactly what guiding found).
 //
-// Training schedule: iteration i (one sample per pixel) belongs to pass p = floor(log2(i + 1)),
-// so pass p covers iterations [2^p - 1, 2^(p+1) - 1): 1, 2, 4, 8, ... samples per pixel, as the
-// paper's doubling training iterations. A pass samples with the distribution learned by the
-// passes before it and records into the next one; the first pass samples the BSDF alone.
-// Learning never stops, so --spp and --time budget training and rendering together.
+// Training schedule (guiding/training_schedule.h): passes of 1, 2, 4, 8, ... samples per pixel,
+// as the paper's doubling training iterations. A pass samples with the distribution learned by
+// the passes before it and records into the next one; the first pass samples the BSDF alone.
+// The final pass, chosen from the --spp or --time budget and the passes' variances (Müller et
+// al. 2017, sec. 5.2), records nothing (no records, sorting or splatting: it costs what
+// sampling the mixture costs) and lasts until the budget is spent. --spp and --time budget
+// training and rendering together.
 //
 // How training enters the image: every pass is an unbiased estimate of the image (it samples
 // with a distribution learned from earlier passes only). The image combines the passes
@@ -48,10 +50,12 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
+#include <chrono>
 #include <nlohmann/json.hpp>
 #include <vector>
 
 #include "guiding/guiding_field.h"
+#include "guiding/training_schedule.h"
 #include "image/inverse_variance.h"
 #include "integrators/camera_path.h"
 
@@ -69,9 +73,8 @@ class GuidedPathTracer final : public CameraPathIntegrator {
   void finish(const Scene& scene, Film& film) override;
   void report(nlohmann::json& stats) const override;
 
-  // The training pass of an iteration: floor(log2(iteration + 1)).
-  static int training_pass(uint32_t iteration);
   const GuidingField& field() const { return field_; }
+  const TrainingSchedule& schedule() const { return schedule_; }
 
  protected:
   Rgb estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng, ScratchArena& arena,
@@ -80,7 +83,8 @@ class GuidedPathTracer final : public CameraPathIntegrator {
  private:
   IntegratorSettings settings_;
   GuidingField field_;
-  int pass_ = 0;
+  TrainingSchedule schedule_;
+  std::chrono::steady_clock::time_point start_;  // prepare(): time budgets
   uint64_t recorded_ = 0;
   size_t peak_record_bytes_ = 0;
   mutable tbb::enumerable_thread_specific<std::vector<GuidingRecord>> records_;

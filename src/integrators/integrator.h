@@ -49,6 +49,13 @@ class Integrator {
  public:
   virtual ~Integrator() = default;
   virtual const char* name() const = 0;
+  // The render loop's budget, before prepare(): spp > 0 samples per pixel, seconds > 0 a time
+  // limit (0: not limited that way). An integrator that splits its budget between learning and
+  // rendering (guided ones) reads it; without it (tests driving iterations) it is unknown.
+  void set_budget(int spp, double seconds) {
+    budget_spp_ = spp;
+    budget_seconds_ = seconds;
+  }
   // Called once before the first iteration.
   virtual void prepare(const Scene& scene, Film& film) {
     (void)scene;
@@ -67,6 +74,14 @@ class Integrator {
   virtual Image image(const Film& film) const;
   // Integrator-specific statistics for the JSON output.
   virtual void report(nlohmann::json& stats) const { (void)stats; }
+
+ protected:
+  int budget_spp() const { return budget_spp_; }
+  double budget_seconds() const { return budget_seconds_; }
+
+ private:
+  int budget_spp_ = 0;
+  double budget_seconds_ = 0;
 };
 
 }  // namespace caustica

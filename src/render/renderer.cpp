@@ -35,6 +35,7 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - paused;
   };
 
+  integrator.set_budget(budget.spp, budget.seconds);
   integrator.prepare(scene, film);
   uint32_t done = 0;         // iterations this rank completed
   bool finished = false;     // this rank has no more work

@@ -28,10 +28,10 @@ struct CostModel {
   // measured one (1 thread, 160 px wide, 16 spp, 2026-11-30: door-ajar 5.3, cornell-box 4.1,
   // veach-bidir 5.0, mis-plates 1.75, coffee 2.7; at 0.75 the model predicted 1.25x less).
   double path_tracing_vertex = 0.6;
-  double light_vertex = 1.1;    // trace, BSDF, store, connect to the lens
-  double connection = 0.6;      // one light vertex connected to one camera vertex
-  double merge_query = 0.18;    // one range query
-  double photon = 0.03;         // one photon gathered
+  double light_vertex = 1.1;  // trace, BSDF, store, connect to the lens
+  double connection = 0.6;    // one light vertex connected to one camera vertex
+  double merge_query = 0.18;  // one range query
+  double photon = 0.03;       // one photon gathered
 };
 constexpr float kLightPathFactors[] = {0.25f, 0.5f, 1.f, 2.f};
 constexpr int kConnections[] = {0, 1, 2, 4};
@@ -56,7 +56,8 @@ CostModel costs_of(const ProbeWork& w, bool measured) {
   const double own_camera = w.camera_seconds - w.connect_seconds - w.merge_seconds;
   t.camera_vertex = per(own_camera, w.camera_vertices, t.camera_vertex);
   // Probes run the core only: pt's vertex is priced at the model's ratio to the core's.
-  t.path_tracing_vertex = t.camera_vertex * (CostModel{}.path_tracing_vertex / CostModel{}.camera_vertex);
+  t.path_tracing_vertex =
+      t.camera_vertex * (CostModel{}.path_tracing_vertex / CostModel{}.camera_vertex);
   t.light_vertex = per(w.light_seconds, w.light_vertices, t.light_vertex);
   t.connection = per(w.connect_seconds, w.connections, t.connection);
   // Queries and photons share one clock: split it in the model's proportion.

@@ -23,14 +23,13 @@ void TrainingSchedule::end_pass(double variance) {
   // Budget spent by the pass that ended, and the budget that was left at its start.
   const bool samples = spp_ > 0;
   const double spent = samples ? double(ended_.length) : ended_.seconds;
-  const double left = samples ? double(spp_) - double(ended_.start)
-                              : seconds_ - ended_.start_seconds;
+  const double left =
+      samples ? double(spp_) - double(ended_.start) : seconds_ - ended_.start_seconds;
   predicted_.push_back(variance >= 0 && left > 0 && spent > 0 ? variance * spent / left : -1);
   if (spp_ <= 0 && seconds_ <= 0) return;  // no budget: train forever
 
   const size_t k = predicted_.size() - 1;
-  if (k >= 1 && predicted_[k] >= 0 && predicted_[k - 1] >= 0 &&
-      predicted_[k] > predicted_[k - 1]) {
+  if (k >= 1 && predicted_[k] >= 0 && predicted_[k - 1] >= 0 && predicted_[k] > predicted_[k - 1]) {
     final_ = true;
     reason_ = "variance";
     return;

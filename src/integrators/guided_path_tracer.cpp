@@ -130,12 +130,14 @@ struct GuidedVertex {
 // What one path teaches the field: its guided vertices and their next event samples.
 class PathLearning {
  public:
+  // weight: the pixels this one stands for (1 in `weight` pixels records; see kMaxRecords).
   PathLearning(ScratchArena& arena, int max_vertices, uint64_t pixel,
-               std::vector<GuidingRecord>& records)
+               std::vector<GuidingRecord>& records, float weight)
       : vertices_(static_cast<GuidedVertex*>(arena.allocate(
             sizeof(GuidedVertex) * size_t(std::max(max_vertices, 1)), alignof(GuidedVertex)))),
         records_(records),
-        key_(pixel * kKeysPerPixel) {}
+        key_(pixel * kKeysPerPixel),
+        weight_(weight) {}
 
   // A contribution c after vertex j is beta_after_j times an estimate of what arrives along its
   // wi; every contribution reaches the vertices before it.
@@ -157,7 +159,7 @@ class PathLearning {
     // samples well (its share of direct light); the path records' product holds only the
     // direction sampling's own MIS-weighted share.
     r.guide_pdf = 0;
-    const float scale = seen.weight / seen.light_pdf;
+    const float scale = weight_ * seen.weight / seen.light_pdf;
     r.radiance = seen.Li.luminance() * scale;
     r.product = (seen.f * seen.Li).luminance() * scale;
     r.statistical_weight = 0;
@@ -168,8 +170,8 @@ class PathLearning {
   void finish() {
     for (int j = 0; j < count_; ++j) {
       GuidedVertex& v = vertices_[j];
-      v.record.radiance = v.incident.luminance() / v.pdf;
-      v.record.product = (v.weight * v.incident).luminance();
+      v.record.radiance = weight_ * v.incident.luminance() / v.pdf;
+      v.record.product = weight_ * (v.weight * v.incident).luminance();
       if (v.record.radiance > 0 && std::isfinite(v.record.radiance)) records_.push_back(v.record);
     }
   }
@@ -189,6 +191,7 @@ class PathLearning {
   int count_ = 0;
   std::vector<GuidingRecord>& records_;
   uint64_t key_;
+  float weight_;
 };
 
 }  // namespace
@@ -201,6 +204,8 @@ void GuidedPathTracer::prepare(const Scene& scene, Film& film) {
   start_ = std::chrono::steady_clock::now();
   recorded_ = 0;
   peak_record_bytes_ = 0;
+  record_stride_ = std::max<uint64_t>(
+      1, (film.pixel_count() * kFirstRecordsPerPixel + kMaxRecords - 1) / kMaxRecords);
 }
 
 void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, Film& film) {
@@ -222,6 +227,10 @@ void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, 
   merged_.clear();
   for (const std::vector<GuidingRecord>& r : records_)
     merged_.insert(merged_.end(), r.begin(), r.end());
+  // The next iteration records one pixel in k, k from this one's records per pixel: the
+  // buffers stay near kMaxRecords at any resolution (deterministic: counts, not threads).
+  const uint64_t per_all_pixels = uint64_t(merged_.size()) * record_stride_;
+  record_stride_ = std::max<uint64_t>(1, (per_all_pixels + kMaxRecords - 1) / kMaxRecords);
   size_t bytes = merged_.capacity() * sizeof(GuidingRecord);
   for (const std::vector<GuidingRecord>& r : records_)
     bytes += r.capacity() * sizeof(GuidingRecord);
@@ -249,12 +258,14 @@ Image GuidedPathTracer::image(const Film& film) const {
 Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng,
                                ScratchArena& arena, uint64_t*) const {
   const MisHeuristic heuristic = settings_.mis_or(MisHeuristic::Power);
-  const bool learn = schedule_.learning();
+  const bool learn =
+      schedule_.learning() && (sample.pixel + sample.iteration) % record_stride_ == 0;
   // The final pass learns nothing: no per-thread buffers are looked up (a hash per pixel).
   std::optional<PathLearning> learning;
   std::vector<uint32_t>* vertex_counts = nullptr;
   if (learn) {
-    learning.emplace(arena, settings_.max_depth, sample.pixel, records_.local());
+    learning.emplace(arena, settings_.max_depth, sample.pixel, records_.local(),
+                     float(record_stride_));
     vertex_counts = &vertex_counts_.local();
     if (vertex_counts->size() != field_.leaf_count()) vertex_counts->assign(field_.leaf_count(), 0);
   }
@@ -312,7 +323,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     eta_scale *= s->eta2;
     beta *= s->weight;
     if (learn && mix.guidable) {
-      ++(*vertex_counts)[mix.record_leaf];
+      (*vertex_counts)[mix.record_leaf] += uint32_t(record_stride_);
       learning->add_vertex(mix, *s, beta);
     }
     prev_pdf = s->pdf;
@@ -340,6 +351,7 @@ void GuidedPathTracer::report(nlohmann::json& stats) const {
   g["guiding_bytes"] = field_.memory_bytes();
   g["guiding_max_bytes"] = settings_.guiding.max_bytes;
   g["record_buffer_peak_bytes"] = peak_record_bytes_;
+  g["record_pixel_stride_last"] = record_stride_;
   g["pass_image_bytes"] = passes_.bytes();
   g["radiance_samples_recorded"] = recorded_;
   g["mean_bsdf_fraction"] = field_.mean_bsdf_fraction();

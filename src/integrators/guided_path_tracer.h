@@ -43,6 +43,11 @@
 // no variance estimate and weight 0 (with two iterations or fewer, the plain average is shown).
 // With --guiding-combine equal every iteration counts the same (unbiased; the film's average).
 //
+// Memory: a training iteration keeps its records until they are splatted; when they would
+// exceed kMaxRecords, the next iteration records one pixel in k (every pixel in turn), each
+// record standing for k (its values and vertex counts times k), so the buffers do not grow
+// with the resolution.
+//
 // Determinism: records carry the key (pixel, position along the path); the field sorts them
 // and splats each spatial leaf's records in that order after the iteration, so the field and
 // the image do not depend on thread scheduling.
@@ -87,6 +92,13 @@ class GuidedPathTracer final : public CameraPathIntegrator {
   std::chrono::steady_clock::time_point start_;  // prepare(): time budgets
   uint64_t recorded_ = 0;
   size_t peak_record_bytes_ = 0;
+  // Records per training iteration are kept near this (40 MiB at 40 bytes; the merged copy and
+  // the sort double it): one pixel in record_stride_ records, its records weighted by the stride
+  // (pixel + iteration ≡ 0 mod stride, so every pixel takes its turn). The first iteration
+  // guesses kFirstRecordsPerPixel (mirror-caustic makes about 14 at 320x240, cornell-box 6).
+  static constexpr size_t kMaxRecords = size_t(1) << 20;
+  static constexpr size_t kFirstRecordsPerPixel = 8;
+  uint64_t record_stride_ = 1;
   mutable tbb::enumerable_thread_specific<std::vector<GuidingRecord>> records_;
   // Path vertices per spatial leaf, per thread (added to the field after each iteration).
   mutable tbb::enumerable_thread_specific<std::vector<uint32_t>> vertex_counts_;

@@ -14,7 +14,6 @@
 
 #include "chi2.h"
 #include "core/math.h"
-#include "core/rng.h"
 #include "guiding/guiding_field.h"
 #include "guiding/training_schedule.h"
 #include "image/inverse_variance.h"
@@ -205,50 +204,6 @@ TEST(Guiding, SidedFieldSeparatesTheFacesOfAThinWall) {
   EXPECT_EQ(field.sampling(field.leaf_at(p, 2)).total(), 0);
   EXPECT_EQ(field.leaf_at({7.f, 0.5f, 0.5f}, 0), field.leaf_at({0.99f, 0.5f, 0.5f}, 0));
   EXPECT_EQ(field.leaf_at({-3.f, 0.5f, 0.5f}, 1), field.leaf_at({0.01f, 0.5f, 0.5f}, 1));
-}
-
-// Lookups start at the deepest node holding a grid cell around the point: the same leaf as a
-// descent from the root, for points inside, on split planes and cell borders, outside the box
-// and not a number.
-TEST(Guiding, StartNodeGridFindsTheSameLeafAsTheRoot) {
-  for (bool sided : {false, true}) {
-    GuidingSettings s;
-    s.spatial_threshold = 100;
-    GuidingField field(Bounds3{{-3, 100, 0}, {5, 101, 0}}, s, sided);  // flat in z, offset in y
-    std::vector<GuidingRecord> records;
-    Pcg32 rng(7, 11);
-    for (uint64_t i = 0; i < 40000; ++i) {
-      // Clustered near one corner, so that the tree is deep there and shallow elsewhere.
-      const Vec3 p(-3 + 8 * sqr(sqr(rng.next_float())), 100 + sqr(sqr(rng.next_float())), 0);
-      GuidingRecord r;
-      r.key = i;
-      r.leaf = field.leaf_at(p, int(i % 6));
-      r.square = {rng.next_float(), rng.next_float()};
-      r.radiance = 1;
-      records.push_back(r);
-    }
-    std::vector<uint32_t> counts(field.leaf_count(), 0);
-    for (const GuidingRecord& r : records) ++counts[r.leaf];
-    field.add_vertex_counts(counts);
-    field.splat(records);
-    field.end_pass(0);
-    ASSERT_GT(field.leaf_count(), 50u) << sided;
-    size_t checked = 0;
-    for (int i = 0; i < 200000; ++i) {
-      Vec3 p(-4 + 10 * rng.next_float(), 99.5f + 2 * rng.next_float(), rng.next_float() - 0.5f);
-      if (i % 2) p = Vec3(-3 + 8 * sqr(sqr(rng.next_float())), 100 + sqr(sqr(rng.next_float())), 0);
-      if (i % 3 == 0) p.x = -3 + 8 * float(rng.next_bounded(64)) / 64.f;  // on cell borders
-      if (i % 5 == 0) p.y = 100 + float(rng.next_bounded(32)) / 32.f;
-      if (i % 7 == 0) p.x = std::nextafter(p.x, -INFINITY);  // just below them: the rounding
-      if (i % 11 == 0) p.y = std::nextafter(p.y, -INFINITY);
-      const int side = sided ? int(rng.next_bounded(6)) : 0;
-      ASSERT_EQ(field.leaf_at(p, side), field.leaf_at_from_root(p, side)) << p.x << " " << p.y;
-      ++checked;
-    }
-    const Vec3 nan(std::nanf(""), 100.5f, 0);
-    EXPECT_EQ(field.leaf_at(nan, 0), field.leaf_at_from_root(nan, 0));
-    EXPECT_EQ(checked, 200000u);
-  }
 }
 
 // The memory cap bounds the whole structure, and memory is reported.

@@ -44,50 +44,7 @@ GuidingField::GuidingField(Bounds3 bounds, const GuidingSettings& settings, bool
     }
     std::fill(counts_.begin(), counts_.end(), 0);
   }
-  root_ = leaves_[0].box;
-  build_start_nodes();
   refresh_guides();
-}
-
-void GuidingField::build_start_nodes() {
-  const Vec3 extent = root_.diagonal();
-  const int copies = sided_ ? 8 : 1;
-  start_dims_[0] = kStartCells * copies;
-  start_dims_[1] = start_dims_[2] = kStartCells;
-  for (int a = 0; a < 3; ++a)
-    start_scale_[a] = extent[a] > 0 ? float(start_dims_[a]) / extent[a] : 0.f;
-  start_nodes_.assign(size_t(start_dims_[0]) * start_dims_[1] * start_dims_[2], 0);
-  for (int k = 0; k < start_dims_[2]; ++k)
-    for (int j = 0; j < start_dims_[1]; ++j)
-      for (int i = 0; i < start_dims_[0]; ++i) {
-        const int cell[3] = {i, j, k};
-        float lo[3], hi[3];
-        for (int a = 0; a < 3; ++a) {
-          // The cell grown by a margin far above the rounding of the cell index (a thousandth
-          // of the cell plus what the coordinates' magnitude rounds to); the first and last
-          // cells reach to infinity, as the clamped index does.
-          const float size = extent[a] / float(start_dims_[a]);
-          const float margin =
-              1e-3f * size + 1e-5f * std::max(std::abs(root_.lo[a]), std::abs(root_.hi[a]));
-          lo[a] = cell[a] == 0 ? -INFINITY : root_.lo[a] + size * float(cell[a]) - margin;
-          hi[a] = cell[a] == start_dims_[a] - 1 || start_scale_[a] == 0
-                      ? INFINITY
-                      : root_.lo[a] + size * float(cell[a] + 1) + margin;
-        }
-        uint32_t node = 0;
-        for (;;) {
-          const SpatialNode n = nodes_[node];
-          if (n.axis() == SpatialNode::kLeaf) break;
-          const int a = int(n.axis());
-          if (hi[a] < n.middle)
-            node = n.index();
-          else if (lo[a] >= n.middle)
-            node = n.index() + 1;
-          else
-            break;
-        }
-        start_nodes_[(size_t(k) * start_dims_[1] + j) * start_dims_[0] + i] = node;
-      }
 }
 
 int GuidingField::side_class(Vec3 n) {
@@ -112,24 +69,9 @@ uint32_t GuidingField::leaf_at(Vec3 p, int side) const {
   return leaf_of_point(class_point(p, side));
 }
 
-uint32_t GuidingField::leaf_at_from_root(Vec3 p, int side) const {
-  const Vec3 q = class_point(p, side);
-  const float coordinate[4] = {q.x, q.y, q.z, 0};
-  SpatialNode n = nodes_[0];
-  while (n.axis() != SpatialNode::kLeaf) n = nodes_[n.index() + (coordinate[n.axis()] >= n.middle)];
-  return n.index();
-}
-
 uint32_t GuidingField::leaf_of_point(Vec3 p) const {
   const float coordinate[4] = {p.x, p.y, p.z, 0};  // indexed without branches
-  size_t cell = 0;
-  for (int a = 2; a >= 0; --a) {
-    const float t = (coordinate[a] - root_.lo[a]) * start_scale_[a];
-    // NaN and points outside the box: the clamped index (NaN compares false: cell 0).
-    const int c = t >= 0 ? int(std::min(t, float(start_dims_[a] - 1))) : 0;
-    cell = cell * size_t(start_dims_[a]) + size_t(c);
-  }
-  SpatialNode n = nodes_[start_nodes_[cell]];
+  SpatialNode n = nodes_[0];
   while (n.axis() != SpatialNode::kLeaf) n = nodes_[n.index() + (coordinate[n.axis()] >= n.middle)];
   return n.index();
 }
@@ -280,7 +222,6 @@ void GuidingField::split_leaves(int k) {
   }
   nodes_.shrink_to_fit();
   leaves_.shrink_to_fit();
-  build_start_nodes();
 }
 
 void GuidingField::end_pass(int k) {
@@ -312,8 +253,7 @@ size_t GuidingField::quadtree_node_count() const {
 
 size_t GuidingField::memory_bytes() const {
   size_t bytes = nodes_.capacity() * sizeof(SpatialNode) + leaves_.capacity() * sizeof(Leaf) +
-                 counts_.capacity() * sizeof(uint64_t) + guides_.capacity() * sizeof(Guide) +
-                 start_nodes_.capacity() * sizeof(uint32_t);
+                 counts_.capacity() * sizeof(uint64_t) + guides_.capacity() * sizeof(Guide);
   for (const Leaf& l : leaves_) bytes += l.sampling.bytes() + l.recording.bytes();
   return bytes;
 }

@@ -71,8 +71,6 @@ class GuidingField {
   // The leaf whose box holds p (points outside the box go to the nearest leaf), in the copy of
   // side class `side` (0 unless the field is sided).
   uint32_t leaf_at(Vec3 p, int side = 0) const;
-  // The same from the root of the tree, without the start-node grid (tests).
-  uint32_t leaf_at_from_root(Vec3 p, int side = 0) const;
   // The leaf of p moved by (u - 1/2) times the size of the box of `leaf` (p's leaf): a sample of
   // the box filter of the spatial splat (Müller 2019). u in [0, 1)^3. It stays in p's class.
   uint32_t jittered_leaf(Vec3 p, uint32_t leaf, Vec3 u, int side = 0) const;
@@ -130,12 +128,6 @@ class GuidingField {
   // Splits a leaf node in two at the middle of `axis` (-1: its box's longest axis).
   void split(uint32_t node, std::vector<uint64_t>& counts, int axis = -1);
   uint32_t leaf_of_point(Vec3 p) const;
-  // A grid over the root box (kStartCells per copy and axis) whose cells hold the deepest node
-  // containing the whole cell (grown by a rounding margin): a descent starts there instead of
-  // at the root, the same leaf for every point (the skipped planes all lie outside the cell).
-  // Rebuilt whenever the tree changes.
-  static constexpr int kStartCells = 8;
-  void build_start_nodes();
   // p clamped into the scene's box along x and moved into the copy of its side class.
   Vec3 class_point(Vec3 p, int side) const;
   void split_leaves(int k);
@@ -146,10 +138,6 @@ class GuidingField {
   float copy_width_ = 0;  // sided: the x extent of one copy
   bool sided_ = false;
   std::vector<SpatialNode> nodes_;  // nodes_[0] is the root
-  Bounds3 root_;                    // the root node's box (all copies, when sided)
-  int start_dims_[3] = {1, 1, 1};
-  Vec3 start_scale_;                   // cells per unit length
-  std::vector<uint32_t> start_nodes_;  // x fastest
   std::vector<Leaf> leaves_;
   std::vector<uint64_t> counts_;        // path vertices per leaf in the current pass
   std::vector<Guide> guides_;           // per leaf

@@ -222,7 +222,6 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
     ++acc.work.connections;
     const VertexGuides light_guides =
         tech_.guided ? guiding_.at(light_si.p, light_si.ng, light_bsdf) : VertexGuides{};
-    if (tech_.guided) light_guides.preset(vertex_guides_[i]);
     const TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si,
                                                   bsdf, cv.mis, light_guides, cv.guides);
     const float w = terms.weight(rules.counts());

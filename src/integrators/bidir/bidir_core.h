@@ -62,8 +62,7 @@ inline float scalar(Rgb v) { return (v.r + v.g + v.b) * (1.f / 3.f); }
 struct LightChunk {
   uint64_t first_path = 0;
   std::vector<LightVertex> vertices;
-  std::vector<VertexGuides::Side> guides;  // guided: per vertex, its arrival side's guides
-  std::vector<uint32_t> path_ends;         // per path: vertices.size() after it
+  std::vector<uint32_t> path_ends;  // per path: vertices.size() after it
   std::vector<Splat> splats;
   std::vector<TechniqueTerms> splat_terms;  // probe iterations: each splat's MIS terms
   uint64_t nonfinite = 0;
@@ -244,7 +243,6 @@ class BidirIntegrator final : public CameraPathIntegrator {
   std::vector<LightChunk> chunk_buffers_;  // one per chunk in flight (trace_light_paths)
   double light_chunk_seconds_ = 0;         // probe iterations: the chunks' tracing times, summed
   std::vector<LightVertex> vertices_;
-  std::vector<VertexGuides::Side> vertex_guides_;  // guided: parallel to vertices_
   std::vector<uint32_t> path_begin_;
   HashGrid grid_;
   Image splat_image_;

@@ -35,7 +35,6 @@ Ray ray_leaving_light(const LightLeSample& le, const Light& light) {
 void BidirIntegrator::trace_light_paths(const Scene& scene, const Iteration& it, Film& film) {
   const auto start = std::chrono::steady_clock::now();
   vertices_.clear();
-  vertex_guides_.clear();
   path_begin_.resize(it.plan.light_paths + 1);
   light_chunk_seconds_ = 0;
   if (tech_.light_to_camera) {
@@ -88,7 +87,6 @@ void BidirIntegrator::trace_chunk(const Scene& scene, const Iteration& it, uint6
                                   LightChunk& chunk) const {
   thread_local ScratchArena arena;
   chunk.vertices.clear();
-  chunk.guides.clear();
   chunk.path_ends.clear();
   chunk.splats.clear();
   chunk.splat_terms.clear();
@@ -115,8 +113,6 @@ void BidirIntegrator::append_chunk(const Iteration& it, const LightChunk& chunk)
   }
   const uint32_t base = uint32_t(vertices_.size());
   vertices_.insert(vertices_.end(), chunk.vertices.begin(), chunk.vertices.end());
-  if (tech_.guided)
-    vertex_guides_.insert(vertex_guides_.end(), chunk.guides.begin(), chunk.guides.end());
   for (size_t i = 0; i < chunk.path_ends.size(); ++i)
     path_begin_[chunk.first_path + i] = base + (i ? chunk.path_ends[i - 1] : 0);
   light_chunk_seconds_ += chunk.seconds;
@@ -171,16 +167,12 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
 
     const VertexGuides guides = tech_.guided ? guiding_.at(si.p, si.ng, bsdf) : VertexGuides{};
     if (!bsdf.is_delta()) {
-      if (tech_.light_to_camera)
-        connect_to_camera(scene, it, si, bsdf, guides, beta, mis, depth, rng, chunk);
       if (stores_vertices()) {
         chunk.vertices.push_back(
             pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}));
-        // What the lens connection looked up (the side wo arrives on) is what connections to
-        // this vertex look up again: kept rather than descended into the fields per connection.
-        if (tech_.guided)
-          chunk.guides.push_back(guides.resolved_side(VertexGuides::side_of(si.ng, si.wo)));
       }
+      if (tech_.light_to_camera)
+        connect_to_camera(scene, it, si, bsdf, guides, beta, mis, depth, rng, chunk);
     }
     if (depth + 1 > max_depth) break;
 

@@ -16,7 +16,6 @@
 // integrator) the density is the BSDF's alone, bit for bit.
 #pragma once
 
-#include <cstdint>
 #include <optional>
 
 #include "core/math.h"
@@ -56,32 +55,6 @@ struct VertexGuides {
   // Only after guide() of the same mode and side.
   float bsdf_fraction(TransportMode mode, Vec3 wo) const { return bsdf[int(mode)][side_of(n, wo)]; }
   void resolve(int side) const;  // bidir_guiding.cpp
-
-  // One resolved side, kept with a stored light vertex (the side its light subpath arrived on,
-  // looked up while tracing it) so that connecting to it needs no spatial descents.
-  struct Side {
-    const DirectionalQuadtree* guides[2] = {nullptr, nullptr};  // [mode]
-    float bsdf[2] = {1, 1};
-    int8_t side = -1;  // -1: nothing resolved
-  };
-  Side resolved_side(int side) const {
-    Side s;
-    if (!fields || !(resolved & (1u << side))) return s;
-    for (int m = 0; m < 2; ++m) {
-      s.guides[m] = guides[m][side];
-      s.bsdf[m] = bsdf[m][side];
-    }
-    s.side = int8_t(side);
-    return s;
-  }
-  void preset(const Side& s) const {
-    if (!fields || s.side < 0) return;
-    for (int m = 0; m < 2; ++m) {
-      guides[m][s.side] = s.guides[m];
-      bsdf[m][s.side] = s.bsdf[m];
-    }
-    resolved |= uint8_t(1u << s.side);
-  }
 
   // The solid-angle density of the guide of (mode, side of wo) at wi; only after guide() found
   // one.

@@ -364,62 +364,96 @@ TEST(Guiding, InverseVarianceCombinationWeightsPasses) {
   EXPECT_NEAR(passes[2].variance, 4.0, 1e-9);
 }
 
-// Without a budget, passes double forever: iteration i is in pass floor(log2(i + 1)).
+// Without a budget, passes double forever: two unguided iterations, then iteration i >= 2 in
+// pass floor(log2(i)).
 TEST(TrainingSchedule, PassesDoubleInLength) {
   TrainingSchedule s;
-  const int expected[] = {0, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 3, 3, 3, 3, 4};
-  for (uint32_t i = 0; i < 16; ++i) {
+  const int expected[] = {0, 0, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 3, 3, 3, 3, 4};
+  for (uint32_t i = 0; i < 17; ++i) {
     if (s.starts_pass(i, 0.0)) s.end_pass(1.0 / double(i));
     EXPECT_EQ(s.pass(), expected[i]) << i;
     EXPECT_TRUE(s.learning());
+    EXPECT_EQ(s.guided(), i >= 2);
   }
 }
 
-// A sample budget: the last pass takes the rest rather than leaving a sliver (64 spp: 1 + 2 +
-// 4 + 8 + 16 training, then 33 in the final pass), and records nothing.
+// A sample budget: the last pass takes the rest rather than leaving a sliver (64 spp: 2 + 2 + 4
+// + 8 + 16 training, then 32 in the final pass), records nothing and is guided.
 TEST(TrainingSchedule, LastPassTakesTheRestOfASampleBudget) {
   for (auto [spp, final_from, passes] :
-       {std::tuple{64, 31, 5}, std::tuple{16, 7, 3}, std::tuple{2, 1, 1}, std::tuple{1, -1, 0}}) {
+       {std::tuple{64, 32, 5}, std::tuple{16, 8, 3}, std::tuple{5, 2, 1}, std::tuple{2, -1, 0}}) {
     TrainingSchedule s(spp, 0);
     for (uint32_t i = 0; i < uint32_t(spp); ++i)
       if (s.starts_pass(i, 0.0)) s.end_pass(1.0 / sqr(double(i)));  // falls: keeps learning
-    EXPECT_EQ(s.final_from(), final_from) << spp;
+    EXPECT_EQ(s.rendering_from(), final_from) << spp;
     EXPECT_EQ(s.pass(), passes) << spp;
     if (final_from >= 0) {
       EXPECT_STREQ(s.reason(), "budget");
+      EXPECT_FALSE(s.learning());
+      EXPECT_TRUE(s.guided());
     }
   }
 }
 
 // Training stops when the predicted final variance V^_k = V_k B_k / R_k rises (Müller 2017, sec.
-// 5.2): with 1000 spp and passes whose per-sample variance stops falling after pass 2, pass 3
-// (the first with V^_3 > V^_2) is the last to learn and pass 4 is final.
+// 5.2), from pass 4 on: with 1000 spp and guided passes whose per-sample variance stops falling
+// after pass 3, pass 4 (V^_4 > V^_3) is the last to learn and rendering starts with pass 5 at
+// iteration 32. The unguided pass 0 is not a point of the curve.
 TEST(TrainingSchedule, StopsLearningWhenItStopsPaying) {
   TrainingSchedule s(1000, 0);
-  // Per-sample variance of passes 0.. (pass 0 has no estimate): 4 (pass 1), 2, 2, 2, ...
-  const double per_sample[] = {-1, 4, 2, 2, 2, 2, 2, 2, 2, 2};
+  const double per_sample[] = {1, 8, 4, 2, 2, 2, 2, 2, 2, 2};
+  const uint32_t length[] = {2, 2, 4, 8, 16, 32, 64, 128, 256, 512};
   for (uint32_t i = 0; i < 1000; ++i)
     if (s.starts_pass(i, 0.0)) {
       const int k = s.pass() - 1;  // the pass that ended
-      s.end_pass(per_sample[k] < 0 ? -1 : per_sample[k] / double(1u << k));
+      s.end_pass(per_sample[k] / double(length[k]));
     }
   EXPECT_STREQ(s.reason(), "variance");
-  EXPECT_EQ(s.final_from(), 15);  // pass 4 starts at iteration 15
+  EXPECT_EQ(s.rendering_from(), 32);
   const auto& v = s.predicted_final_variances();
-  ASSERT_EQ(v.size(), 4u);
+  ASSERT_EQ(v.size(), 5u);
   EXPECT_LT(v[0], 0);
-  EXPECT_LT(v[2], v[1]);
-  EXPECT_GT(v[3], v[2]);
+  EXPECT_LT(v[3], v[2]);
+  EXPECT_GT(v[4], v[3]);
+  EXPECT_TRUE(s.guided());
 }
 
-// Rendering trains the field: after 15 iterations (passes 0..3) it has learned radiance and
-// refined its quadtrees; the statistics report it.
+// A time budget: rendering starts with a trial, a guided and an unguided pass of equal length
+// (half the last training pass), and the one with the lower variance x seconds renders the rest.
+// Guided passes with 1.2x lower variance per sample that take 1.5x the time lose; at equal cost
+// they win.
+TEST(TrainingSchedule, TimeBudgetSwitchesGuidingOffWhenItDoesNotPay) {
+  for (const double guided_cost : {1.5, 1.0}) {
+    TrainingSchedule s(0, 10.0);
+    double t = 0;
+    uint32_t start = 0, trial_length[2] = {0, 0};
+    for (uint32_t i = 0; !s.final_pass() && i < 100000; ++i) {
+      const bool was_guided = s.guided(), was_trial = s.rendering_from() >= 0;
+      if (s.starts_pass(i, t)) {
+        if (was_trial) trial_length[was_guided] = i - start;
+        s.end_pass((was_guided ? 1.0 : 1.2) / double(i - start));
+        start = i;
+      }
+      t += s.guided() ? 0.001 * guided_cost : 0.001;  // seconds per iteration
+    }
+    ASSERT_TRUE(s.final_pass()) << guided_cost;
+    EXPECT_GE(trial_length[1], 4u);
+    EXPECT_EQ(trial_length[0], trial_length[1]);
+    EXPECT_EQ(s.guided(), guided_cost == 1.0) << guided_cost;
+    EXPECT_GT(s.trial_guided_tau(), 0);
+    EXPECT_GT(s.trial_unguided_tau(), 0);
+  }
+}
+
+// Rendering trains the field: 16 spp are passes of 2 (unguided), 2 and 4 samples per pixel and a
+// final pass of 8; the field has learned radiance and refined its quadtrees, and the statistics
+// report it.
 TEST(GuidedPathTracer, RenderingTrainsTheField) {
   auto scene = make_builtin_scene("cornell", 32, 32);
   IntegratorSettings settings;
   GuidedPathTracer integrator(settings);
   RenderBudget budget;
-  budget.spp = 15;
+  budget.spp = 16;
   RenderCallbacks cb;
   cb.quiet = true;
   render(*scene, integrator, budget, cb);
@@ -429,7 +463,9 @@ TEST(GuidedPathTracer, RenderingTrainsTheField) {
   EXPECT_GT(d.node_count(), 1u);
   nlohmann::json stats;
   integrator.report(stats);
-  EXPECT_EQ(stats["guiding"]["training_passes_completed"], 3);
+  EXPECT_EQ(stats["guiding"]["passes_started"], 4);
+  EXPECT_EQ(stats["guiding"]["rendering_from_iteration"], 8);
+  EXPECT_EQ(stats["guiding"]["rendering_guided"], true);
   EXPECT_GT(stats["guiding"]["guiding_bytes"].get<size_t>(), 0u);
   // The report's views of the learned field (guide_views.h): 9 pixels; where something was
   // learned, a density over the sphere that integrates to about 1 (midpoints of 32 x 16 cells).
@@ -448,7 +484,7 @@ TEST(GuidedPathTracer, RenderingTrainsTheField) {
 }
 
 // The registry's determinism oracle renders 3 iterations (one splat feeds the sampling); here
-// the 12-spp schedule (passes of 1, 2, then a final 9) samples with fields learned from
+// the 12-spp schedule (passes of 2, 2, then a final 8) samples with fields learned from
 // multi-threaded splats and decides when to stop learning from the passes' variances: still
 // bit-identical.
 TEST(GuidedPathTracer, TrainedFieldBitIdenticalForOneAndTwoThreads) {

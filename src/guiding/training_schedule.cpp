@@ -1,8 +1,23 @@
 #include "guiding/training_schedule.h"
 
+#include <algorithm>
 #include <cstddef>
 
 namespace caustica {
+
+bool TrainingSchedule::guided() const {
+  switch (phase_) {
+    case Phase::Training:
+      return pass_ > 0;
+    case Phase::TrialGuided:
+      return true;
+    case Phase::TrialUnguided:
+      return false;
+    case Phase::Rendering:
+      return rendering_guided_;
+  }
+  return true;
+}
 
 bool TrainingSchedule::starts_pass(uint32_t iteration, double elapsed) {
   if (iteration == 0) {
@@ -10,8 +25,9 @@ bool TrainingSchedule::starts_pass(uint32_t iteration, double elapsed) {
     pass_start_seconds_ = elapsed;
     return false;
   }
-  if (final_ || iteration < pass_start_ + pass_length_) return false;
+  if (phase_ == Phase::Rendering || iteration < pass_start_ + pass_length_) return false;
   ended_ = {pass_start_, pass_length_, pass_start_seconds_, elapsed - pass_start_seconds_};
+  ended_phase_ = phase_;
   ++pass_;
   pass_start_ = iteration;
   pass_length_ = pass_ < 31 ? 1u << pass_ : 1u << 31;
@@ -20,18 +36,35 @@ bool TrainingSchedule::starts_pass(uint32_t iteration, double elapsed) {
 }
 
 void TrainingSchedule::end_pass(double variance) {
-  // Budget spent by the pass that ended, and the budget that was left at its start.
+  const double tau_seconds = variance >= 0 && ended_.seconds > 0 ? variance * ended_.seconds : -1;
+  if (ended_phase_ == Phase::TrialGuided) {
+    trial_tau_[1] = tau_seconds;
+    phase_ = Phase::TrialUnguided;
+    pass_length_ = ended_.length;
+    return;
+  }
+  if (ended_phase_ == Phase::TrialUnguided) {
+    trial_tau_[0] = tau_seconds;
+    rendering_guided_ =
+        !(trial_tau_[0] >= 0 && trial_tau_[1] >= 0 && trial_tau_[0] < trial_tau_[1]);
+    phase_ = Phase::Rendering;
+    return;
+  }
+  // A training pass ended: the budget it spent, and the budget that was left at its start.
   const bool samples = spp_ > 0;
   const double spent = samples ? double(ended_.length) : ended_.seconds;
   const double left =
       samples ? double(spp_) - double(ended_.start) : seconds_ - ended_.start_seconds;
-  predicted_.push_back(variance >= 0 && left > 0 && spent > 0 ? variance * spent / left : -1);
+  // Pass 0 samples the BSDF alone: not a point of the training curve (a first guided pass,
+  // learned from two samples per pixel, may well be worse).
+  const size_t k = predicted_.size();
+  predicted_.push_back(k > 0 && variance >= 0 && left > 0 && spent > 0 ? variance * spent / left
+                                                                       : -1);
   if (spp_ <= 0 && seconds_ <= 0) return;  // no budget: train forever
 
-  const size_t k = predicted_.size() - 1;
-  if (k >= 1 && predicted_[k] >= 0 && predicted_[k - 1] >= 0 && predicted_[k] > predicted_[k - 1]) {
-    final_ = true;
-    reason_ = "variance";
+  if (k >= kFirstVarianceStop && predicted_[k] >= 0 && predicted_[k - 1] >= 0 &&
+      predicted_[k] > predicted_[k - 1]) {
+    stop_training("variance");
     return;
   }
   // Too little left for the next pass and a longer one after it: the next pass takes the rest.
@@ -43,10 +76,19 @@ void TrainingSchedule::end_pass(double variance) {
     next = 2 * ended_.seconds;
     remaining = seconds_ - pass_start_seconds_;
   }
-  if (remaining - next < 2 * next) {
-    final_ = true;
-    reason_ = "budget";
+  if (remaining - next < 2 * next) stop_training("budget");
+}
+
+void TrainingSchedule::stop_training(const char* reason) {
+  reason_ = reason;
+  rendering_from_ = pass_start_;
+  if (spp_ > 0) {
+    phase_ = Phase::Rendering;
+    rendering_guided_ = true;
+    return;
   }
+  phase_ = Phase::TrialGuided;
+  pass_length_ = std::max(kMinTrial, ended_.length / 2);
 }
 
 }  // namespace caustica

@@ -2,24 +2,34 @@
 // "Practical Path Guiding", sec. 5.2 and its implementation), shared by guided-pt and the
 // guided bidirectional integrators.
 //
-// Training passes double: pass k renders 2^k iterations (one sample per pixel each), samples
-// with the field learned by the passes before it and records into the next one. One pass is
-// final: it samples with the field as it is and records nothing, so it costs only the sampling,
-// and it lasts until the budget is spent. Which pass is final:
-//  - with a sample budget B, the next pass when after it fewer than twice its length would
-//    remain (Müller's rule: the last pass takes the rest, never a sliver of a pass);
+// Training passes double: pass 0 renders 2 iterations (one sample per pixel each) with the BSDF
+// alone, pass k >= 1 renders 2^k, samples with the field learned by the passes before it and
+// records into the next one. Rendering starts when
+//  - with a sample budget B, after the next pass fewer than twice its length would remain
+//    (Müller's rule: the last pass takes the rest, never a sliver of a pass);
 //  - with a time budget, the same rule with the next pass's predicted seconds (twice the last);
-//  - with either, when learning stopped paying: with tau_k = V_k B_k (the variance of pass k's
-//    image times the budget it took, samples or seconds) and R_k the budget left at its start,
-//    the final image's variance had training stopped after pass k is V^_k = tau_k / R_k; the
-//    pass after the first k with V^_k > V^_{k-1} is final (V^ is convex when training has
-//    diminishing returns, sec. 5.2).
+//  - with either, learning stopped paying: with tau_k = V_k B_k (the variance of pass k's image
+//    times the budget it took, samples or seconds) and R_k the budget left at its start, the
+//    final image's variance had training stopped after pass k is V^_k = tau_k / R_k; rendering
+//    starts after the first k >= 4 with V^_k > V^_{k-1} (V^ is convex when training has
+//    diminishing returns, sec. 5.2). The variances of passes of 2-8 samples per pixel are too
+//    noisy to stop on: on door-ajar (320x240) they stopped training after 8 samples in one run
+//    of two, with 32 the other time.
+// Rendering passes record nothing: they cost only the sampling. With a sample budget there is
+// one, guided, to the end (per sample, the learned selection probability already falls back
+// to the BSDF where the guide does not help). With a time budget, guiding must also pay for its
+// time: rendering begins with a trial, one pass guided and one unguided of equal length (half
+// the last training pass, at least 8), and the one with the lower variance x seconds (the
+// inverse of efficiency) renders the rest. A two-sample unguided pass 0 cannot decide this: its
+// variance estimate misses the rare, bright paths that dominate scenes such as door-ajar (2 spp
+// measured 32 per sample there, 43 over the whole unguided render).
 // Without a budget (an integrator driven iteration by iteration) training never stops.
 //
 // Determinism: with a sample budget the decisions depend on the passes' variances only, which
 // the inverse-variance combiner computes in a fixed order; only time budgets read the clock.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -35,36 +45,54 @@ class TrainingSchedule {
   // iteration 0). `elapsed` is the seconds since the render began (time budgets only).
   bool starts_pass(uint32_t iteration, double elapsed);
   // After a pass has ended (starts_pass returned true): its variance (V_k, the variance of its
-  // pixel mean; negative: unknown). Decides whether the pass now starting is final.
+  // pixel mean; negative: unknown). Decides what the pass now starting does.
   void end_pass(double variance);
 
   int pass() const { return pass_; }
-  bool final_pass() const { return final_; }
-  // Whether the current pass records what it sees (every pass but the final one).
-  bool learning() const { return !final_; }
-  // The iteration the final pass began at (-1 while training).
-  int64_t final_from() const { return final_ ? int64_t(pass_start_) : -1; }
-  // Why the final pass is final: "budget" (too little left for another pass) or "variance"
-  // (V^ rose), empty while training.
+  // Whether the current pass records what it sees (training passes).
+  bool learning() const { return phase_ == Phase::Training; }
+  // Whether the pass that just ended (when starts_pass returned true) was a training pass: its
+  // records are to be learned.
+  bool ended_learning() const { return ended_phase_ == Phase::Training; }
+  // Whether the current pass samples the learned field.
+  bool guided() const;
+  bool final_pass() const { return phase_ == Phase::Rendering; }
+  // The first iteration that learns nothing (-1 while training).
+  int64_t rendering_from() const { return rendering_from_; }
+  // Why training stopped: "budget" (too little left for another pass) or "variance" (V^ rose);
+  // empty while training.
   const char* reason() const { return reason_; }
 
-  // For each completed pass, V^_k as above (negative when unknown).
+  // For each completed training pass, V^_k as above (negative when unknown, and for pass 0).
   const std::vector<double>& predicted_final_variances() const { return predicted_; }
+  // The trial of a time budget: variance x seconds of its guided and unguided pass (negative
+  // until measured).
+  double trial_guided_tau() const { return trial_tau_[1]; }
+  double trial_unguided_tau() const { return trial_tau_[0]; }
 
  private:
+  enum class Phase { Training, TrialGuided, TrialUnguided, Rendering };
+  static constexpr size_t kFirstVarianceStop = 4;  // the variance rule from training pass 4 on
+  static constexpr uint32_t kMinTrial = 8;         // iterations per trial pass, at least
+  void stop_training(const char* reason);
+
   int spp_ = 0;
   double seconds_ = 0;
+  Phase phase_ = Phase::Training;
+  Phase ended_phase_ = Phase::Training;
   int pass_ = 0;
   uint32_t pass_start_ = 0;  // first iteration of the current pass
-  uint32_t pass_length_ = 1;
+  uint32_t pass_length_ = 2;
   double pass_start_seconds_ = 0;
   struct Ended {
     uint32_t start = 0, length = 0;
     double start_seconds = 0, seconds = 0;
   } ended_;  // the pass that ended last
-  bool final_ = false;
+  int64_t rendering_from_ = -1;
+  bool rendering_guided_ = true;
   const char* reason_ = "";
   std::vector<double> predicted_;
+  double trial_tau_[2] = {-1, -1};  // [guided]
 };
 
 }  // namespace caustica

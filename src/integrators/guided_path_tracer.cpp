@@ -213,10 +213,10 @@ void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, 
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   if (schedule_.starts_pass(iteration, elapsed)) {
     schedule_.end_pass(passes_.passes().back().variance);
-    field_.end_pass(schedule_.pass() - 1);
+    if (schedule_.ended_learning()) field_.end_pass(schedule_.pass() - 1);
     passes_.end_pass();
   }
-  if (!schedule_.learning()) {  // the final pass: sampling only
+  if (!schedule_.learning()) {  // rendering: sampling only
     trace_camera_paths(scene, iteration, film);
     passes_.end_iteration();
     return;
@@ -260,6 +260,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
   const MisHeuristic heuristic = settings_.mis_or(MisHeuristic::Power);
   const bool learn =
       schedule_.learning() && (sample.pixel + sample.iteration) % record_stride_ == 0;
+  const bool guided = schedule_.guided();
   // The final pass learns nothing: no per-thread buffers are looked up (a hash per pixel).
   std::optional<PathLearning> learning;
   std::vector<uint32_t>* vertex_counts = nullptr;
@@ -294,7 +295,11 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     if (depth++ == settings_.max_depth) break;
 
     const Vec3 wo = si.wo;
-    const Mixture mix = mixture_at(field_, learn && settings_.guiding.filter, si, bsdf, rng);
+    // An unguided final pass (guiding did not pay) looks nothing up: `pt` with guided-pt's
+    // roulette.
+    const Mixture mix = learn || guided
+                            ? mixture_at(field_, learn && settings_.guiding.filter, si, bsdf, rng)
+                            : Mixture{};
     // Next event estimation asks for the mixture density toward the light (not for a delta
     // light); what it evaluated is kept for the record.
     DirectionPdfs nee_pdfs;
@@ -341,9 +346,13 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
 
 void GuidedPathTracer::report(nlohmann::json& stats) const {
   nlohmann::json g;
-  g["training_passes_completed"] = schedule_.pass();
-  g["final_pass_from_iteration"] = schedule_.final_from();
-  g["final_pass_reason"] = schedule_.reason();
+  g["passes_started"] = schedule_.pass() + 1;
+  g["rendering_from_iteration"] = schedule_.rendering_from();
+  g["training_stopped_by"] = schedule_.reason();
+  if (schedule_.trial_guided_tau() >= 0 || schedule_.trial_unguided_tau() >= 0)
+    g["trial_variance_seconds"] = {{"guided", schedule_.trial_guided_tau()},
+                                   {"unguided", schedule_.trial_unguided_tau()}};
+  if (schedule_.final_pass()) g["rendering_guided"] = schedule_.guided();
   g["predicted_final_variances"] = schedule_.predicted_final_variances();
   g["spatial_leaves"] = field_.leaf_count();
   g["spatial_nodes"] = field_.spatial_node_count();

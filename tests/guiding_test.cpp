@@ -396,12 +396,12 @@ TEST(TrainingSchedule, LastPassTakesTheRestOfASampleBudget) {
 }
 
 // Training stops when the predicted final variance V^_k = V_k B_k / R_k rises (Müller 2017, sec.
-// 5.2), from pass 4 on: with 1000 spp and guided passes whose per-sample variance stops falling
-// after pass 3, pass 4 (V^_4 > V^_3) is the last to learn and rendering starts with pass 5 at
-// iteration 32. The unguided pass 0 is not a point of the curve.
+// 5.2), from pass 5 on: with 1000 spp and guided passes whose per-sample variance stops falling
+// after pass 4, pass 5 (V^_5 > V^_4) is the last to learn and rendering starts with pass 6 at
+// iteration 64. The unguided pass 0 is not a point of the curve.
 TEST(TrainingSchedule, StopsLearningWhenItStopsPaying) {
   TrainingSchedule s(1000, 0);
-  const double per_sample[] = {1, 8, 4, 2, 2, 2, 2, 2, 2, 2};
+  const double per_sample[] = {1, 16, 8, 4, 2, 2, 2, 2, 2, 2};
   const uint32_t length[] = {2, 2, 4, 8, 16, 32, 64, 128, 256, 512};
   for (uint32_t i = 0; i < 1000; ++i)
     if (s.starts_pass(i, 0.0)) {
@@ -409,26 +409,26 @@ TEST(TrainingSchedule, StopsLearningWhenItStopsPaying) {
       s.end_pass(per_sample[k] / double(length[k]));
     }
   EXPECT_STREQ(s.reason(), "variance");
-  EXPECT_EQ(s.rendering_from(), 32);
+  EXPECT_EQ(s.rendering_from(), 64);
   const auto& v = s.predicted_final_variances();
-  ASSERT_EQ(v.size(), 5u);
+  ASSERT_EQ(v.size(), 6u);
   EXPECT_LT(v[0], 0);
-  EXPECT_LT(v[3], v[2]);
-  EXPECT_GT(v[4], v[3]);
+  EXPECT_LT(v[4], v[3]);
+  EXPECT_GT(v[5], v[4]);
   EXPECT_TRUE(s.guided());
 }
 
-// A time budget: rendering starts with a trial, a guided and an unguided pass of equal length
-// (half the last training pass), and the one with the lower variance x seconds renders the rest.
-// Guided passes with 1.2x lower variance per sample that take 1.5x the time lose; at equal cost
-// they win.
+// A time budget: after training pass 3 a trial renders a guided and an unguided pass of equal
+// length, and variance x seconds decides. Guided passes with 1.2x lower variance per sample that
+// take 1.5x the time lose: rendering goes on unguided at once. At equal cost guiding wins,
+// training goes on, and the render stays guided.
 TEST(TrainingSchedule, TimeBudgetSwitchesGuidingOffWhenItDoesNotPay) {
   for (const double guided_cost : {1.5, 1.0}) {
     TrainingSchedule s(0, 10.0);
     double t = 0;
     uint32_t start = 0, trial_length[2] = {0, 0};
     for (uint32_t i = 0; !s.final_pass() && i < 100000; ++i) {
-      const bool was_guided = s.guided(), was_trial = s.rendering_from() >= 0;
+      const bool was_guided = s.guided(), was_trial = s.in_trial();
       if (s.starts_pass(i, t)) {
         if (was_trial) trial_length[was_guided] = i - start;
         s.end_pass((was_guided ? 1.0 : 1.2) / double(i - start));
@@ -437,11 +437,19 @@ TEST(TrainingSchedule, TimeBudgetSwitchesGuidingOffWhenItDoesNotPay) {
       t += s.guided() ? 0.001 * guided_cost : 0.001;  // seconds per iteration
     }
     ASSERT_TRUE(s.final_pass()) << guided_cost;
-    EXPECT_GE(trial_length[1], 4u);
-    EXPECT_EQ(trial_length[0], trial_length[1]);
+    EXPECT_EQ(trial_length[1], 8u);
+    EXPECT_EQ(trial_length[0], 8u);
     EXPECT_EQ(s.guided(), guided_cost == 1.0) << guided_cost;
     EXPECT_GT(s.trial_guided_tau(), 0);
     EXPECT_GT(s.trial_unguided_tau(), 0);
+    if (guided_cost > 1) {
+      EXPECT_STREQ(s.reason(), "trial");
+      EXPECT_EQ(s.rendering_from(), 32);  // training 2 + 2 + 4 + 8, trial 8 + 8
+      EXPECT_EQ(s.training_passes(), 4);
+    } else {
+      EXPECT_STREQ(s.reason(), "variance");  // no gain per sample after the trial
+      EXPECT_EQ(s.training_passes(), 6);
+    }
   }
 }
 

@@ -8,7 +8,7 @@ namespace caustica {
 bool TrainingSchedule::guided() const {
   switch (phase_) {
     case Phase::Training:
-      return pass_ > 0;
+      return training_pass_ > 0;
     case Phase::TrialGuided:
       return true;
     case Phase::TrialUnguided:
@@ -30,9 +30,14 @@ bool TrainingSchedule::starts_pass(uint32_t iteration, double elapsed) {
   ended_phase_ = phase_;
   ++pass_;
   pass_start_ = iteration;
-  pass_length_ = pass_ < 31 ? 1u << pass_ : 1u << 31;
   pass_start_seconds_ = elapsed;
   return true;
+}
+
+void TrainingSchedule::train_on() {
+  phase_ = Phase::Training;
+  ++training_pass_;
+  pass_length_ = training_pass_ < 31 ? 1u << training_pass_ : 1u << 31;
 }
 
 void TrainingSchedule::end_pass(double variance) {
@@ -45,9 +50,18 @@ void TrainingSchedule::end_pass(double variance) {
   }
   if (ended_phase_ == Phase::TrialUnguided) {
     trial_tau_[0] = tau_seconds;
-    rendering_guided_ =
+    const bool guided_wins =
         !(trial_tau_[0] >= 0 && trial_tau_[1] >= 0 && trial_tau_[0] < trial_tau_[1]);
-    phase_ = Phase::Rendering;
+    if (rendering_from_ >= 0 || !guided_wins) {  // the trial after training, or guiding lost
+      if (rendering_from_ < 0) {
+        reason_ = "trial";
+        rendering_from_ = pass_start_;
+      }
+      phase_ = Phase::Rendering;
+      rendering_guided_ = guided_wins;
+    } else {
+      train_on();  // the early trial: guiding pays already, and learning goes on
+    }
     return;
   }
   // A training pass ended: the budget it spent, and the budget that was left at its start.
@@ -60,29 +74,36 @@ void TrainingSchedule::end_pass(double variance) {
   const size_t k = predicted_.size();
   predicted_.push_back(k > 0 && variance >= 0 && left > 0 && spent > 0 ? variance * spent / left
                                                                        : -1);
-  if (spp_ <= 0 && seconds_ <= 0) return;  // no budget: train forever
-
+  if (spp_ <= 0 && seconds_ <= 0) {  // no budget: train forever
+    train_on();
+    return;
+  }
   if (k >= kFirstVarianceStop && predicted_[k] >= 0 && predicted_[k - 1] >= 0 &&
       predicted_[k] > predicted_[k - 1]) {
     stop_training("variance");
     return;
   }
   // Too little left for the next pass and a longer one after it: the next pass takes the rest.
-  double next = 0, remaining = 0;
-  if (samples) {
-    next = double(pass_length_);
-    remaining = double(spp_) - double(pass_start_);
-  } else {
-    next = 2 * ended_.seconds;
-    remaining = seconds_ - pass_start_seconds_;
+  const double next = samples ? double(2u << k) : 2 * ended_.seconds;
+  const double remaining =
+      samples ? double(spp_) - double(pass_start_) : seconds_ - pass_start_seconds_;
+  if (remaining - next < 2 * next) {
+    stop_training("budget");
+    return;
   }
-  if (remaining - next < 2 * next) stop_training("budget");
+  if (!samples && k == kEarlyTrialAfter && !early_trial_) {
+    early_trial_ = true;
+    phase_ = Phase::TrialGuided;
+    pass_length_ = kMinTrial;
+    return;
+  }
+  train_on();
 }
 
 void TrainingSchedule::stop_training(const char* reason) {
   reason_ = reason;
   rendering_from_ = pass_start_;
-  if (spp_ > 0) {
+  if (spp_ > 0 || early_trial_) {  // no time to weigh, or guiding won the early trial
     phase_ = Phase::Rendering;
     rendering_guided_ = true;
     return;

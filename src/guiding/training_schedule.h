@@ -1,6 +1,6 @@
 // How a guided integrator splits its budget between learning and rendering (Müller et al. 2017,
-// "Practical Path Guiding", sec. 5.2 and its implementation), shared by guided-pt and the
-// guided bidirectional integrators.
+// "Practical Path Guiding", sec. 5.2 and its implementation), used by guided-pt (the guided
+// bidirectional integrators still learn in doubling passes to the end: bidir_guiding.h).
 //
 // Training passes double: pass 0 renders 2 iterations (one sample per pixel each) with the BSDF
 // alone, pass k >= 1 renders 2^k, samples with the field learned by the passes before it and
@@ -11,18 +11,22 @@
 //  - with either, learning stopped paying: with tau_k = V_k B_k (the variance of pass k's image
 //    times the budget it took, samples or seconds) and R_k the budget left at its start, the
 //    final image's variance had training stopped after pass k is V^_k = tau_k / R_k; rendering
-//    starts after the first k >= 4 with V^_k > V^_{k-1} (V^ is convex when training has
-//    diminishing returns, sec. 5.2). The variances of passes of 2-8 samples per pixel are too
-//    noisy to stop on: on door-ajar (320x240) they stopped training after 8 samples in one run
-//    of two, with 32 the other time.
+//    starts after the first k >= 5 with V^_k > V^_{k-1} (V^ is convex when training has
+//    diminishing returns, sec. 5.2). The variances of short passes are too noisy to stop on:
+//    on door-ajar (320x240) passes of 2-8 samples per pixel stopped training after 8 in one run
+//    of two, and the per-sample variance of a 16-sample pass was 26.4 in one run and 32.7 in
+//    another with the same field (training stopped, and the render was 1.15x worse).
 // Rendering passes record nothing: they cost only the sampling. With a sample budget there is
 // one, guided, to the end (per sample, the learned selection probability already falls back
 // to the BSDF where the guide does not help). With a time budget, guiding must also pay for its
-// time: rendering begins with a trial, one pass guided and one unguided of equal length (half
-// the last training pass, at least 8), and the one with the lower variance x seconds (the
-// inverse of efficiency) renders the rest. A two-sample unguided pass 0 cannot decide this: its
-// variance estimate misses the rare, bright paths that dominate scenes such as door-ajar (2 spp
-// measured 32 per sample there, 43 over the whole unguided render).
+// time, which trials decide: one pass guided and one unguided of equal length, and the one
+// with the lower variance x seconds (the inverse of efficiency) wins. The first trial (8
+// iterations each) follows training pass 3: if guiding loses, rendering starts unguided at
+// once (an easy scene stops paying for training early); if it wins, training goes on and the
+// render stays guided. Without that trial (training stopped earlier), one follows training
+// (half the last training pass each, at least 8). A two-sample unguided pass 0 cannot decide
+// this: its variance estimate misses the rare, bright paths that dominate scenes such as
+// door-ajar (2 spp measured 32 per sample there, 43 over the whole unguided render).
 // Without a budget (an integrator driven iteration by iteration) training never stops.
 //
 // Determinism: with a sample budget the decisions depend on the passes' variances only, which
@@ -52,15 +56,18 @@ class TrainingSchedule {
   // Whether the current pass records what it sees (training passes).
   bool learning() const { return phase_ == Phase::Training; }
   // Whether the pass that just ended (when starts_pass returned true) was a training pass: its
-  // records are to be learned.
+  // records are to be learned, as training pass ended_training_pass().
   bool ended_learning() const { return ended_phase_ == Phase::Training; }
+  int ended_training_pass() const { return training_pass_; }  // valid until end_pass()
+  int training_passes() const { return training_pass_ + 1; }  // started, the current included
   // Whether the current pass samples the learned field.
   bool guided() const;
   bool final_pass() const { return phase_ == Phase::Rendering; }
+  bool in_trial() const { return phase_ == Phase::TrialGuided || phase_ == Phase::TrialUnguided; }
   // The first iteration that learns nothing (-1 while training).
   int64_t rendering_from() const { return rendering_from_; }
-  // Why training stopped: "budget" (too little left for another pass) or "variance" (V^ rose);
-  // empty while training.
+  // Why training stopped: "budget" (too little left for another pass), "variance" (V^ rose)
+  // or "trial" (guiding lost the early trial); empty while training.
   const char* reason() const { return reason_; }
 
   // For each completed training pass, V^_k as above (negative when unknown, and for pass 0).
@@ -72,15 +79,19 @@ class TrainingSchedule {
 
  private:
   enum class Phase { Training, TrialGuided, TrialUnguided, Rendering };
-  static constexpr size_t kFirstVarianceStop = 4;  // the variance rule from training pass 4 on
+  static constexpr size_t kFirstVarianceStop = 5;  // the variance rule from training pass 5 on
   static constexpr uint32_t kMinTrial = 8;         // iterations per trial pass, at least
+  static constexpr size_t kEarlyTrialAfter = 3;    // time budgets: the first trial
   void stop_training(const char* reason);
+  void train_on();  // the next training pass
 
   int spp_ = 0;
   double seconds_ = 0;
   Phase phase_ = Phase::Training;
   Phase ended_phase_ = Phase::Training;
-  int pass_ = 0;
+  int pass_ = 0;           // passes started, trials included
+  int training_pass_ = 0;  // the current or last training pass
+  bool early_trial_ = false;
   uint32_t pass_start_ = 0;  // first iteration of the current pass
   uint32_t pass_length_ = 2;
   double pass_start_seconds_ = 0;

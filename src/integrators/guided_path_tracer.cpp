@@ -212,8 +212,10 @@ void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, 
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   if (schedule_.starts_pass(iteration, elapsed)) {
+    const bool learned = schedule_.ended_learning();
+    const int k = schedule_.ended_training_pass();
     schedule_.end_pass(passes_.passes().back().variance);
-    if (schedule_.ended_learning()) field_.end_pass(schedule_.pass() - 1);
+    if (learned) field_.end_pass(k);
     passes_.end_pass();
   }
   if (!schedule_.learning()) {  // rendering: sampling only
@@ -347,6 +349,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
 void GuidedPathTracer::report(nlohmann::json& stats) const {
   nlohmann::json g;
   g["passes_started"] = schedule_.pass() + 1;
+  g["training_passes"] = schedule_.training_passes();
   g["rendering_from_iteration"] = schedule_.rendering_from();
   g["training_stopped_by"] = schedule_.reason();
   if (schedule_.trial_guided_tau() >= 0 || schedule_.trial_unguided_tau() >= 0)

@@ -396,9 +396,9 @@ TEST(TrainingSchedule, LastPassTakesTheRestOfASampleBudget) {
 }
 
 // Training stops when the predicted final variance V^_k = V_k B_k / R_k rises (Müller 2017, sec.
-// 5.2), from pass 5 on: with 1000 spp and guided passes whose per-sample variance stops falling
-// after pass 4, pass 5 (V^_5 > V^_4) is the last to learn and rendering starts with pass 6 at
-// iteration 64. The unguided pass 0 is not a point of the curve.
+// 5.2) twice in a row, from pass 5 on: with 1000 spp and guided passes whose per-sample variance
+// stops falling after pass 4, pass 6 (V^_6 > V^_5 > V^_4) is the last to learn and rendering
+// starts with pass 7 at iteration 128. The unguided pass 0 is not a point of the curve.
 TEST(TrainingSchedule, StopsLearningWhenItStopsPaying) {
   TrainingSchedule s(1000, 0);
   const double per_sample[] = {1, 16, 8, 4, 2, 2, 2, 2, 2, 2};
@@ -409,12 +409,13 @@ TEST(TrainingSchedule, StopsLearningWhenItStopsPaying) {
       s.end_pass(per_sample[k] / double(length[k]));
     }
   EXPECT_STREQ(s.reason(), "variance");
-  EXPECT_EQ(s.rendering_from(), 64);
+  EXPECT_EQ(s.rendering_from(), 128);
   const auto& v = s.predicted_final_variances();
-  ASSERT_EQ(v.size(), 6u);
+  ASSERT_EQ(v.size(), 7u);
   EXPECT_LT(v[0], 0);
   EXPECT_LT(v[4], v[3]);
   EXPECT_GT(v[5], v[4]);
+  EXPECT_GT(v[6], v[5]);
   EXPECT_TRUE(s.guided());
 }
 
@@ -453,6 +454,19 @@ TEST(TrainingSchedule, TimeBudgetSwitchesGuidingOffWhenItDoesNotPay) {
   }
 }
 
+// Renders `spp` samples per pixel with the render loop (which gives the integrator its budget)
+// and returns its statistics.
+static nlohmann::json render_and_report(const Scene& scene, GuidedPathTracer& integrator, int spp) {
+  RenderBudget budget;
+  budget.spp = spp;
+  RenderCallbacks cb;
+  cb.quiet = true;
+  render(scene, integrator, budget, cb);
+  nlohmann::json stats;
+  integrator.report(stats);
+  return stats;
+}
+
 // Rendering trains the field: 16 spp are passes of 2 (unguided), 2 and 4 samples per pixel and a
 // final pass of 8; the field has learned radiance and refined its quadtrees, and the statistics
 // report it.
@@ -460,17 +474,11 @@ TEST(GuidedPathTracer, RenderingTrainsTheField) {
   auto scene = make_builtin_scene("cornell", 32, 32);
   IntegratorSettings settings;
   GuidedPathTracer integrator(settings);
-  RenderBudget budget;
-  budget.spp = 16;
-  RenderCallbacks cb;
-  cb.quiet = true;
-  render(*scene, integrator, budget, cb);
+  const nlohmann::json stats = render_and_report(*scene, integrator, 16);
   const GuidingField& field = integrator.field();
   const DirectionalQuadtree& d = field.sampling(field.leaf_at(scene->bounds().center()));
   EXPECT_GT(d.total(), 0);
   EXPECT_GT(d.node_count(), 1u);
-  nlohmann::json stats;
-  integrator.report(stats);
   EXPECT_EQ(stats["guiding"]["passes_started"], 4);
   EXPECT_EQ(stats["guiding"]["rendering_from_iteration"], 8);
   EXPECT_EQ(stats["guiding"]["rendering_guided"], true);
@@ -514,13 +522,7 @@ TEST(GuidedPathTracer, RecordBuffersAreBoundedAtHighResolution) {
     IntegratorSettings settings;
     settings.max_depth = 4;
     GuidedPathTracer integrator(settings);
-    RenderBudget budget;
-    budget.spp = 3;
-    RenderCallbacks cb;
-    cb.quiet = true;
-    render(*scene, integrator, budget, cb);
-    nlohmann::json stats;
-    integrator.report(stats);
+    const nlohmann::json stats = render_and_report(*scene, integrator, 3);
     std::printf("[ records ] %dx%d: peak %.1f MB, stride %d\n", size, size,
                 stats["guiding"]["record_buffer_peak_bytes"].get<double>() * 1e-6,
                 stats["guiding"]["record_pixel_stride_last"].get<int>());

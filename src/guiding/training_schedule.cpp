@@ -78,7 +78,7 @@ void TrainingSchedule::end_pass(double variance) {
     train_on();
     return;
   }
-  if (k >= kFirstVarianceStop && predicted_[k] >= 0 && predicted_[k - 1] >= 0 &&
+  if (k >= kFirstVarianceStop && predicted_[k - 2] >= 0 && predicted_[k - 1] > predicted_[k - 2] &&
       predicted_[k] > predicted_[k - 1]) {
     stop_training("variance");
     return;

@@ -208,7 +208,8 @@ size_t GuidingField::leaf_bytes(const Leaf& l) const {
 }
 
 void GuidingField::split_leaves(int k) {
-  const double threshold = settings_.spatial_threshold * std::sqrt(std::ldexp(1.0, k));
+  const double threshold =
+      settings_.threshold_or(GuidingSettings::kMuellerThreshold) * std::sqrt(std::ldexp(1.0, k));
   size_t bytes = memory_bytes();
   std::vector<uint64_t>& counts = counts_;
   // nodes_ grows inside the loop: new children are visited too, so a leaf splits repeatedly.

@@ -269,7 +269,8 @@ std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene) {
   GuidingSettings settings;
   settings.spatial_threshold = 200;
   settings.bsdf_fraction = 0.3f;
-  g->prepare(scene.bounds(), settings, 1024);
+  g->prepare(scene.bounds(), settings, 1024, 0, 0);  // no budget: it trains forever
+  const InverseVarianceCombiner no_variances;
   std::mt19937 gen(5);
   std::uniform_real_distribution<float> u(0.f, 1.f);
   const Bounds3 b = scene.bounds();
@@ -281,7 +282,7 @@ std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene) {
     return scene.intersect(ray, si);
   };
   for (int pass = 0; pass < 3; ++pass) {
-    g->begin_iteration(uint32_t((1u << pass) - 1));
+    g->begin_iteration(uint32_t(pass == 0 ? 0 : 1u << pass), 0.0, no_variances);  // 0, 2, 4
     std::vector<LightVertex> photons;
     for (int i = 0; i < 6000; ++i) {
       SurfaceInteraction si;
@@ -293,7 +294,7 @@ std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene) {
     }
     g->end_iteration(scene, photons);
   }
-  g->begin_iteration(7);  // ends the last pass: its distributions are sampled from
+  g->begin_iteration(8, 0.0, no_variances);  // ends the last pass: its fields are sampled
   return g;
 }
 

@@ -36,6 +36,7 @@ Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pc
     if (settings_.bidir.measured_costs) acc.work.camera_seconds = seconds_since(start);
   }
   add_work(acc.work);
+  if (tech_.guided) camera_values_[sample.pixel] = acc.sum * acc.filter_weight;
   return acc.sum;
 }
 

@@ -259,8 +259,12 @@ class BidirIntegrator final : public CameraPathIntegrator {
   ProbeWork work_total_;             // operations counted over all iterations (counts only)
   std::vector<std::string> technique_files_;
 
-  // guided-bpt / guided-vcm: the learned fields.
+  // guided-bpt / guided-vcm: the learned fields, and per-pass pixel moments for their schedule
+  // (camera_values_: this iteration's camera estimate per pixel, each written by its task).
   BidirGuiding guiding_;
+  InverseVarianceCombiner guided_passes_;
+  mutable std::vector<Rgb> camera_values_;
+  std::chrono::steady_clock::time_point start_;
 
   // adaptive-vcm: the plan, and the work of the current probe iteration.
   mutable AdaptivePlan plan_;

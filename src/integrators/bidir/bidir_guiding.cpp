@@ -18,33 +18,44 @@ constexpr float kDefaultBsdfFraction = 0.5f;
 
 }  // namespace
 
-void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint64_t pixels) {
+void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint64_t pixels,
+                           int spp, double seconds) {
   enabled_ = true;
   if (settings.bsdf_fraction < 0) settings.bsdf_fraction = kDefaultBsdfFraction;
   settings.max_bytes /= 2;
   radiance_ = GuidingField(bounds, settings, /*sided=*/true);
   importance_ = GuidingField(bounds, settings, /*sided=*/true);
-  pass_ = 0;
+  schedule_ = TrainingSchedule(spp, seconds);
   iteration_ = 0;
   // About four camera vertices per path: one pixel in k keeps the records under kMaxRecords.
   camera_stride_ = std::max<uint64_t>(1, (4 * pixels + kMaxRecords - 1) / kMaxRecords);
   radiance_records_ = importance_records_ = 0;
 }
 
-void BidirGuiding::begin_iteration(uint32_t iteration) {
+bool BidirGuiding::begin_iteration(uint32_t iteration, double elapsed,
+                                   const InverseVarianceCombiner& passes) {
   iteration_ = iteration;
-  const int pass = std::bit_width(uint64_t(iteration) + 1) - 1;
-  if (pass > pass_) {
-    radiance_.end_pass(pass_);
-    importance_.end_pass(pass_);
-    pass_ = pass;
+  bool new_pass = false;
+  if (schedule_.starts_pass(iteration, elapsed)) {
+    const bool learned = schedule_.ended_learning();
+    const int k = schedule_.ended_training_pass();
+    const std::vector<InverseVarianceCombiner::Pass> all = passes.passes();
+    schedule_.end_pass(all.empty() ? -1.0 : all.back().variance);
+    if (learned) {
+      radiance_.end_pass(k);
+      importance_.end_pass(k);
+    }
+    new_pass = true;
   }
   for (std::vector<GuidingRecord>& r : camera_records_) r.clear();
+  return new_pass;
 }
 
 VertexGuides BidirGuiding::at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const {
   VertexGuides g;
-  if (!enabled_ || is_specular(bsdf.flags()) || bsdf.is_delta() || bsdf.stochastic()) return g;
+  if (!enabled_ || !schedule_.guided() || is_specular(bsdf.flags()) || bsdf.is_delta() ||
+      bsdf.stochastic())
+    return g;
   g.fields = this;
   g.p = p;
   g.n = ng;
@@ -106,6 +117,7 @@ void BidirGuiding::learn(GuidingField& field, std::vector<GuidingRecord>& record
 
 void BidirGuiding::end_iteration(const Scene& scene,
                                  const std::vector<LightVertex>& light_vertices) {
+  if (!schedule_.learning()) return;
   // Radiance from the light vertices: every k-th one, shifted by the iteration.
   const size_t n = light_vertices.size();
   const size_t stride = std::max<size_t>(1, (n + kMaxRecords - 1) / kMaxRecords);
@@ -143,7 +155,14 @@ void BidirGuiding::make_views(const Scene& scene) {
 
 void BidirGuiding::report(nlohmann::json& stats) const {
   nlohmann::json g;
-  g["training_passes_completed"] = pass_;
+  g["passes_started"] = schedule_.pass() + 1;
+  g["training_passes"] = schedule_.training_passes();
+  g["rendering_from_iteration"] = schedule_.rendering_from();
+  g["training_stopped_by"] = schedule_.reason();
+  if (schedule_.trial_guided_tau() >= 0 || schedule_.trial_unguided_tau() >= 0)
+    g["trial_variance_seconds"] = {{"guided", schedule_.trial_guided_tau()},
+                                   {"unguided", schedule_.trial_unguided_tau()}};
+  if (schedule_.final_pass()) g["rendering_guided"] = schedule_.guided();
   g["radiance_spatial_leaves"] = radiance_.leaf_count();
   g["importance_spatial_leaves"] = importance_.leaf_count();
   g["radiance_guiding_bytes"] = radiance_.memory_bytes();

@@ -13,9 +13,13 @@
 // kept (every k-th vertex, weighted by k, the k-th shifted with the iteration), which bounds the
 // memory of the records independently of the resolution.
 //
-// Schedule (as guided-pt): iteration i belongs to training pass floor(log2(i + 1)); a pass
-// samples with what the passes before it learned, so iteration 0 is plain bpt / vcm, and every
-// iteration is an unbiased estimate. The image is the plain average of all iterations.
+// Schedule: guided-pt's (guiding/training_schedule.h): two unguided iterations, doubling
+// training passes that sample with what the passes before them learned, then rendering passes
+// that record nothing; with a time budget, trials decide whether guiding pays for its time
+// (variance x seconds of a guided and an unguided pass of equal length), and an unguided
+// render is plain bpt / vcm. The passes' variances come from the integrator's per-pass pixel
+// moments (an InverseVarianceCombiner fed with each iteration's pixel values, splats included).
+// Every iteration is an unbiased estimate; the image is the plain average of all iterations.
 //
 // Sides: both fields are sided (GuidingField::side_class: the geometric normal facing the side a
 // record arrived on), so that the two faces of a thin wall, or a floor and the wall it meets, do
@@ -36,6 +40,8 @@
 #include <vector>
 
 #include "guiding/guiding_field.h"
+#include "guiding/training_schedule.h"
+#include "image/inverse_variance.h"
 #include "integrators/bidir/light_vertex.h"
 #include "integrators/bidir/vertex_guides.h"
 
@@ -50,22 +56,29 @@ class BidirGuiding {
   static constexpr size_t kMaxRecords = size_t(1) << 18;
 
   BidirGuiding() = default;
-  void prepare(const Bounds3& bounds, GuidingSettings settings, uint64_t pixels);
+  // spp, seconds: the render's budget (Integrator::set_budget).
+  void prepare(const Bounds3& bounds, GuidingSettings settings, uint64_t pixels, int spp,
+               double seconds);
   bool enabled() const { return enabled_; }
 
-  // Before iteration i: ends the training pass when i starts a new one.
-  void begin_iteration(uint32_t iteration);
+  // Before iteration i, `elapsed` seconds into the render: when i starts a new pass, the
+  // schedule weighs the pass that ended (its variance: the last of `passes`), its fields learn
+  // what it recorded, and true is returned (the caller then ends the pass in `passes`).
+  bool begin_iteration(uint32_t iteration, double elapsed, const InverseVarianceCombiner& passes);
+  bool learning() const { return schedule_.learning(); }
   // The guides at a vertex at p with geometric normal ng and this BSDF (empty where it is not
   // guided).
   VertexGuides at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const;
 
-  // Camera vertices of `pixel` are recorded this iteration (one pixel in k).
-  bool records_pixel(uint64_t pixel) const { return (pixel + iteration_) % camera_stride_ == 0; }
+  // Camera vertices of `pixel` are recorded this iteration (one pixel in k, while training).
+  bool records_pixel(uint64_t pixel) const {
+    return schedule_.learning() && (pixel + iteration_) % camera_stride_ == 0;
+  }
   // The camera subpath of `pixel` reached a non-delta vertex at p (geometric normal ng),
   // arriving along -wo with throughput beta (from estimate(): any thread).
   void record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 ng, Vec3 wo, Rgb beta) const;
   // After the camera pass: learns from this iteration's light vertices (their normals from the
-  // scene) and camera records.
+  // scene) and camera records (training passes only).
   void end_iteration(const Scene& scene, const std::vector<LightVertex>& light_vertices);
 
   // What was learned at a few pixels (guide_views.h): the radiance camera subpaths see and the
@@ -82,7 +95,7 @@ class BidirGuiding {
 
   bool enabled_ = false;
   GuidingField radiance_, importance_;
-  int pass_ = 0;
+  TrainingSchedule schedule_;
   uint32_t iteration_ = 0;
   uint64_t camera_stride_ = 1;
   uint64_t radiance_records_ = 0, importance_records_ = 0;

@@ -76,7 +76,13 @@ void BidirIntegrator::prepare(const Scene& scene, Film& film) {
                                             : kDefaultRadiusFactor * std::max(scene_radius, 1e-3f);
   light_paths_ = settings_.bidir.light_paths > 0 ? settings_.bidir.light_paths : film.pixel_count();
   if (!settings_.bidir.techniques_dir.empty()) techniques_.reset(film.width(), film.height());
-  if (tech_.guided) guiding_.prepare(scene.bounds(), settings_.guiding, film.pixel_count());
+  if (tech_.guided) {
+    guiding_.prepare(scene.bounds(), settings_.guiding, film.pixel_count(), budget_spp(),
+                     budget_seconds());
+    guided_passes_ = InverseVarianceCombiner(film.width(), film.height());
+    camera_values_.assign(film.pixel_count(), Rgb(0.f));
+    start_ = std::chrono::steady_clock::now();
+  }
   if (tech_.adaptive)
     plan_ = AdaptivePlan(film.width(), film.height(), settings_.bidir.measured_costs,
                          settings_.bidir.probe_every_iteration);
@@ -110,7 +116,8 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   it.merge_normalization = n ? 1.f / (kPi * it.radius * it.radius * float(n)) : 0.f;
   it.light_path_of =
       LightPathAssignment(film.pixel_count(), std::max<uint64_t>(n, 1), iteration, settings_.seed);
-  if (tech_.guided) guiding_.begin_iteration(iteration);
+  if (tech_.guided && guiding_.begin_iteration(iteration, seconds_since(start_), guided_passes_))
+    guided_passes_.end_pass();
   probe_ = {};
   probe_.light_paths = double(n);
   if (it.plan.probe) plan_.begin_probe(it.radius);
@@ -137,7 +144,13 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   trace_camera_paths(scene, iteration, film);
   collect_work();
   camera_seconds_total_ += seconds_since(camera_start);
-  if (tech_.guided) guiding_.end_iteration(scene, vertices_);
+  if (tech_.guided) {
+    guiding_.end_iteration(scene, vertices_);
+    // The pass's pixel moments for the schedule: camera estimates plus this iteration's splats.
+    for (size_t p = 0; p < camera_values_.size(); ++p)
+      guided_passes_.add(p, camera_values_[p] + splat_image_[p]);
+    guided_passes_.end_iteration();
+  }
   probe_.light_vertices = double(vertices_.size());
   add_counts(work_total_, probe_);
   if (it.plan.probe) {

@@ -1,6 +1,6 @@
 // How a guided integrator splits its budget between learning and rendering (Müller et al. 2017,
-// "Practical Path Guiding", sec. 5.2 and its implementation), used by guided-pt (the guided
-// bidirectional integrators still learn in doubling passes to the end: bidir_guiding.h).
+// "Practical Path Guiding", sec. 5.2 and its implementation), shared by guided-pt and the guided
+// bidirectional integrators (bidir_guiding.h).
 //
 // Training passes double: pass 0 renders 2 iterations (one sample per pixel each) with the BSDF
 // alone, pass k >= 1 renders 2^k, samples with the field learned by the passes before it and

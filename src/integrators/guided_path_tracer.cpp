@@ -9,6 +9,7 @@
 #include "film/film.h"
 #include "integrators/guide_views.h"
 #include "integrators/path_vertex.h"
+#include "integrators/schedule_report.h"
 #include "lights/light.h"
 #include "lights/light_sampler.h"
 #include "materials/material.h"
@@ -350,15 +351,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
 
 void GuidedPathTracer::report(nlohmann::json& stats) const {
   nlohmann::json g;
-  g["passes_started"] = schedule_.pass() + 1;
-  g["training_passes"] = schedule_.training_passes();
-  g["rendering_from_iteration"] = schedule_.rendering_from();
-  g["training_stopped_by"] = schedule_.reason();
-  if (schedule_.trial_guided_tau() >= 0 || schedule_.trial_unguided_tau() >= 0)
-    g["trial_variance_seconds"] = {{"guided", schedule_.trial_guided_tau()},
-                                   {"unguided", schedule_.trial_unguided_tau()}};
-  if (schedule_.final_pass()) g["rendering_guided"] = schedule_.guided();
-  g["predicted_final_variances"] = schedule_.predicted_final_variances();
+  report_schedule(schedule_, g);
   g["spatial_leaves"] = field_.leaf_count();
   g["spatial_nodes"] = field_.spatial_node_count();
   g["quadtree_nodes"] = field_.quadtree_node_count();

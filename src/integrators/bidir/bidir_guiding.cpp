@@ -7,6 +7,7 @@
 
 #include "core/rng.h"
 #include "integrators/guide_views.h"
+#include "integrators/schedule_report.h"
 #include "scene/scene.h"
 
 namespace caustica::bidir {
@@ -155,14 +156,7 @@ void BidirGuiding::make_views(const Scene& scene) {
 
 void BidirGuiding::report(nlohmann::json& stats) const {
   nlohmann::json g;
-  g["passes_started"] = schedule_.pass() + 1;
-  g["training_passes"] = schedule_.training_passes();
-  g["rendering_from_iteration"] = schedule_.rendering_from();
-  g["training_stopped_by"] = schedule_.reason();
-  if (schedule_.trial_guided_tau() >= 0 || schedule_.trial_unguided_tau() >= 0)
-    g["trial_variance_seconds"] = {{"guided", schedule_.trial_guided_tau()},
-                                   {"unguided", schedule_.trial_unguided_tau()}};
-  if (schedule_.final_pass()) g["rendering_guided"] = schedule_.guided();
+  report_schedule(schedule_, g);
   g["radiance_spatial_leaves"] = radiance_.leaf_count();
   g["importance_spatial_leaves"] = importance_.leaf_count();
   g["radiance_guiding_bytes"] = radiance_.memory_bytes();

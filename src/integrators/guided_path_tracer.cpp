@@ -1,7 +1,6 @@
 #include "integrators/guided_path_tracer.h"
 
 #include <algorithm>
-#include <bit>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -266,7 +265,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
   const bool learn =
       schedule_.learning() && (sample.pixel + sample.iteration) % record_stride_ == 0;
   const bool guided = schedule_.guided();
-  // The final pass learns nothing: no per-thread buffers are looked up (a hash per pixel).
+  // Rendering passes and unrecorded pixels learn nothing: no per-thread buffers are looked up.
   std::optional<PathLearning> learning;
   std::vector<uint32_t>* vertex_counts = nullptr;
   if (learn) {

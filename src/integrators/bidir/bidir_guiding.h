@@ -65,7 +65,6 @@ class BidirGuiding {
   // schedule weighs the pass that ended (its variance: the last of `passes`), its fields learn
   // what it recorded, and true is returned (the caller then ends the pass in `passes`).
   bool begin_iteration(uint32_t iteration, double elapsed, const InverseVarianceCombiner& passes);
-  bool learning() const { return schedule_.learning(); }
   // The guides at a vertex at p with geometric normal ng and this BSDF (empty where it is not
   // guided).
   VertexGuides at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const;

@@ -265,6 +265,11 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
   const bool learn =
       schedule_.learning() && (sample.pixel + sample.iteration) % record_stride_ == 0;
   const bool guided = schedule_.guided();
+  if (!learn && !guided) {  // an unguided rendering pass: exactly pt's estimator, and as fast
+    const Rgb L = unguided_.radiance(scene, sample.ray, rng, arena);
+    passes_.add(sample.pixel, L * sample.filter_weight);
+    return L;
+  }
   // Rendering passes and unrecorded pixels learn nothing: no per-thread buffers are looked up.
   std::optional<PathLearning> learning;
   std::vector<uint32_t>* vertex_counts = nullptr;
@@ -299,11 +304,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     if (depth++ == settings_.max_depth) break;
 
     const Vec3 wo = si.wo;
-    // An unguided final pass (guiding did not pay) looks nothing up: `pt` with guided-pt's
-    // roulette.
-    const Mixture mix = learn || guided
-                            ? mixture_at(field_, learn && settings_.guiding.filter, si, bsdf, rng)
-                            : Mixture{};
+    const Mixture mix = mixture_at(field_, learn && settings_.guiding.filter, si, bsdf, rng);
     // Next event estimation asks for the mixture density toward the light (not for a delta
     // light); what it evaluated is kept for the record.
     DirectionPdfs nee_pdfs;

@@ -63,13 +63,14 @@
 #include "guiding/training_schedule.h"
 #include "image/inverse_variance.h"
 #include "integrators/camera_path.h"
+#include "integrators/path_tracer.h"
 
 namespace caustica {
 
 class GuidedPathTracer final : public CameraPathIntegrator {
  public:
   explicit GuidedPathTracer(const IntegratorSettings& settings)
-      : CameraPathIntegrator(settings.seed), settings_(settings) {}
+      : CameraPathIntegrator(settings.seed), settings_(settings), unguided_(settings) {}
   const char* name() const override { return "guided-pt"; }
 
   void prepare(const Scene& scene, Film& film) override;
@@ -87,6 +88,7 @@ class GuidedPathTracer final : public CameraPathIntegrator {
 
  private:
   IntegratorSettings settings_;
+  PathTracer unguided_;  // renders when guiding did not pay (with --time: the schedule's trials)
   GuidingField field_;
   TrainingSchedule schedule_;
   std::chrono::steady_clock::time_point start_;  // prepare(): time budgets

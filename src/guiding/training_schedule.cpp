@@ -50,8 +50,11 @@ void TrainingSchedule::end_pass(double variance) {
   }
   if (ended_phase_ == Phase::TrialUnguided) {
     trial_tau_[0] = tau_seconds;
+    // The early trial measures a field learned from 16 samples per pixel, which training will
+    // only improve: guiding is switched off there only if it lost clearly.
+    const double margin = rendering_from_ >= 0 ? 1.0 : kEarlyTrialMargin;
     const bool guided_wins =
-        !(trial_tau_[0] >= 0 && trial_tau_[1] >= 0 && trial_tau_[0] < trial_tau_[1]);
+        !(trial_tau_[0] >= 0 && trial_tau_[1] >= 0 && trial_tau_[0] * margin < trial_tau_[1]);
     if (rendering_from_ >= 0 || !guided_wins) {  // the trial after training, or guiding lost
       if (rendering_from_ < 0) {
         reason_ = "trial";

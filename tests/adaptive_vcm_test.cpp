@@ -48,6 +48,20 @@ double measured_relative_variance(const Scene& scene, const std::string& integra
   return rel / double(sum.size());
 }
 
+// The statistics of adaptive-vcm after `iterations` iterations on the scene.
+nlohmann::json adaptive_stats(const Scene& scene, const IntegratorSettings& s, int iterations) {
+  auto in = make_integrator("adaptive-vcm", s);
+  Film film(scene.camera().width(), scene.camera().height());
+  in->prepare(scene, film);
+  for (int i = 0; i < iterations; ++i) {
+    in->render_iteration(scene, uint32_t(i), film);
+    film.end_iteration();
+  }
+  nlohmann::json stats;
+  in->report(stats);
+  return stats;
+}
+
 struct Prediction {
   double no_merge = 0, all_merge = 0;
 };
@@ -56,16 +70,7 @@ struct Prediction {
 std::map<std::pair<float, int>, Prediction> predicted(const Scene& scene, IntegratorSettings s,
                                                       int probes) {
   s.bidir.probe_every_iteration = true;
-  auto in = make_integrator("adaptive-vcm", s);
-  const int w = scene.camera().width(), h = scene.camera().height();
-  Film film(w, h);
-  in->prepare(scene, film);
-  for (int i = 0; i < probes; ++i) {
-    in->render_iteration(scene, uint32_t(i), film);
-    film.end_iteration();
-  }
-  nlohmann::json stats;
-  in->report(stats);
+  const nlohmann::json stats = adaptive_stats(scene, s, probes);
   std::map<std::pair<float, int>, Prediction> out;
   for (const auto& c : stats["adaptive"]["history"].back()["candidates"])
     out[{c["light_path_factor"].get<float>(), c["connections"].get<int>()}] = {
@@ -116,15 +121,7 @@ TEST(AdaptiveVcm, KeepsMergingForCausticsAndReportsWhy) {
   auto scene = make_builtin_scene("cornell-glass", 48, 48);
   IntegratorSettings s;
   s.max_depth = 8;
-  auto in = make_integrator("adaptive-vcm", s);
-  Film film(48, 48);
-  in->prepare(*scene, film);
-  for (uint32_t i = 0; i < 16; ++i) {
-    in->render_iteration(*scene, i, film);
-    film.end_iteration();
-  }
-  nlohmann::json stats;
-  in->report(stats);
+  const nlohmann::json stats = adaptive_stats(*scene, s, 16);
   const auto& a = stats["adaptive"];
   ASSERT_FALSE(a["history"].empty());
   EXPECT_EQ(a["probes"].get<int>(), 5);  // iterations 0, 1, 3, 7, 15
@@ -149,15 +146,7 @@ TEST(AdaptiveVcm, PathTracingIterationsRunPathTracersEstimator) {
   auto scene = make_builtin_scene("cornell", 32, 32);
   IntegratorSettings s;
   s.max_depth = 5;
-  auto in = make_integrator("adaptive-vcm", s);
-  Film film(32, 32);
-  in->prepare(*scene, film);
-  for (uint32_t i = 0; i < 32; ++i) {
-    in->render_iteration(*scene, i, film);
-    film.end_iteration();
-  }
-  nlohmann::json stats;
-  in->report(stats);
+  const nlohmann::json stats = adaptive_stats(*scene, s, 32);
   const auto& a = stats["adaptive"];
   EXPECT_EQ(a["light_paths_per_iteration"].get<uint64_t>(), 0u);
   EXPECT_EQ(a["probes"].get<int>(), 6);  // iterations 0, 1, 3, 7, 15, 31

@@ -67,7 +67,8 @@ class TrainingSchedule {
   bool guided() const;
   bool final_pass() const { return phase_ == Phase::Rendering; }
   bool in_trial() const { return phase_ == Phase::TrialGuided || phase_ == Phase::TrialUnguided; }
-  // The first iteration that learns nothing (-1 while training).
+  // The first iteration of the rendering passes, the ones after training and its trials (-1
+  // while training goes on).
   int64_t rendering_from() const { return rendering_from_; }
   // Why training stopped: "budget" (too little left for another pass), "variance" (V^ rose)
   // or "trial" (guiding lost the early trial); empty while training.

@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <barrier>
 #include <cstdlib>
+#include <mutex>
+#include <thread>
 #include <vector>
 
 #include "film/film.h"
@@ -96,6 +99,10 @@ class PretendRank final : public Ranks {
     return true;
   }
   void sum_films(const Film& mine, Film*) override { out_->add(mine); }
+  bool all_sum_films(const Film&, Film*, bool) override {
+    ADD_FAILURE() << "a lone pretend rank cannot sum films with the others";
+    return true;
+  }
   int agree(int status, const std::string&, std::string* message) override {
     message->clear();
     return status;
@@ -135,6 +142,139 @@ TEST(RanksRender, TwoRanksIterationsGiveTheOneProcessImageBitForBit) {
       if (!(image[i] == single.image[i])) ++differing;
     EXPECT_EQ(differing, 0u) << name;
   }
+}
+
+// Two ranks as two threads of this process, for what needs the ranks to meet: all_sum_films
+// is a real sum over both (a barrier on each side of it), while progress rounds report, as
+// PretendRank's, that the other rank finishes when this one does. stop_from: the shared
+// iteration sums from which on rank 1 asks to stop (none by default).
+struct ThreadPair {
+  explicit ThreadPair(int width, int height) : meet(2), total(width, height) {}
+  std::barrier<> meet;
+  const Film* films[2] = {nullptr, nullptr};
+  bool stops[2] = {false, false};
+  Film total;  // the final films' sum
+  std::mutex total_mutex;
+  int sums = 0;  // shared sums made (rank 0 counts)
+};
+
+class ThreadRank final : public Ranks {
+ public:
+  ThreadRank(int rank, ThreadPair* pair, int stop_at_sum = -1)
+      : rank_(rank), pair_(pair), stop_at_sum_(stop_at_sum) {}
+  int rank() const override { return rank_; }
+  int size() const override { return 2; }
+  void start_round(const RoundState& mine) override { round_ = mine; }
+  bool poll_round(RoundState* totals, bool) override {
+    *totals = round_;
+    totals->finished *= 2;
+    return true;
+  }
+  void sum_films(const Film& mine, Film*) override {
+    const std::lock_guard<std::mutex> lock(pair_->total_mutex);
+    pair_->total.add(mine);
+  }
+  bool all_sum_films(const Film& mine, Film* total, bool stop) override {
+    pair_->films[rank_] = &mine;
+    pair_->stops[rank_] = stop || sums_ == stop_at_sum_;
+    ++sums_;
+    pair_->meet.arrive_and_wait();  // both films are in place and stay unchanged
+    total->set_counts(0, 0);
+    for (FixedSum& f : total->sums()) f = 0;
+    total->add(*pair_->films[0]);
+    total->add(*pair_->films[1]);
+    const bool any = pair_->stops[0] || pair_->stops[1];
+    if (rank_ == 0) ++pair_->sums;
+    pair_->meet.arrive_and_wait();  // both have read before either renders on
+    return any;
+  }
+  int agree(int status, const std::string&, std::string* message) override {
+    message->clear();
+    return status;
+  }
+  void wait_all() override {}
+  [[noreturn]] void abort(int code) override { std::_Exit(code); }
+
+ private:
+  int rank_;
+  ThreadPair* pair_;
+  int stop_at_sum_;
+  int sums_ = 0;
+  RoundState round_;
+};
+
+// Renders `spp` iterations of `name` on two thread ranks; the sum of their films.
+struct PairResult {
+  Image image;
+  uint32_t iterations[2] = {0, 0};
+  bool interrupted[2] = {false, false};
+  int sums = 0;
+};
+PairResult render_on_thread_pair(const Scene& scene, const char* name,
+                                 const IntegratorSettings& settings, int spp,
+                                 int rank1_stops_at_sum = -1) {
+  const int w = scene.camera().width(), h = scene.camera().height();
+  ThreadPair pair(w, h);
+  PairResult result;
+  auto run = [&](int rank) {
+    ThreadRank me(rank, &pair, rank == 1 ? rank1_stops_at_sum : -1);
+    auto integrator = make_integrator(name, settings);
+    RenderBudget budget;
+    budget.spp = spp;
+    RenderCallbacks cb;
+    cb.quiet = true;
+    cb.ranks = &me;
+    const RenderResult r = render(scene, *integrator, budget, cb);
+    result.iterations[rank] = r.local_iterations;
+    result.interrupted[rank] = r.interrupted;
+  };
+  std::thread other(run, 1);
+  run(0);
+  other.join();
+  result.image = pair.total.image();
+  result.sums = pair.sums;
+  return result;
+}
+
+// adaptive-vcm learns from its probes (iterations 0, 1, 3, 7, ...): every rank renders each of
+// them, and the means that normalise their variances come from the film summed over the ranks,
+// so the choices and the image are those of one process.
+TEST(RanksRender, AdaptiveVcmOnTwoRanksGivesTheOneProcessImageBitForBit) {
+  auto scene = make_builtin_scene("cornell-glass", 24, 20);
+  IntegratorSettings settings;
+  settings.seed = 7;
+  const int spp = 12;
+  const RenderResult single = test::render_with(*scene, "adaptive-vcm", spp, settings);
+  const PairResult pair = render_on_thread_pair(*scene, "adaptive-vcm", settings, spp);
+  EXPECT_EQ(pair.iterations[0], 6u);  // its own: 0, 2, ..., 10
+  EXPECT_EQ(pair.iterations[1], 6u);
+  EXPECT_EQ(pair.sums, 4) << "one sum of the films before each probe: 0, 1, 3, 7";
+  size_t differing = 0;
+  for (size_t i = 0; i < pair.image.pixel_count(); ++i)
+    if (!(pair.image[i] == single.image[i])) ++differing;
+  EXPECT_EQ(differing, 0u);
+  // A different seed changes the image, or the comparison proves nothing.
+  settings.seed = 8;
+  const RenderResult other = test::render_with(*scene, "adaptive-vcm", spp, settings);
+  differing = 0;
+  for (size_t i = 0; i < other.image.pixel_count(); ++i)
+    if (!(other.image[i] == single.image[i])) ++differing;
+  EXPECT_GT(differing, 0u);
+}
+
+// A stop asked for on one rank reaches the other at the next shared sums: both end there,
+// interrupted, instead of one waiting for the other forever.
+TEST(RanksRender, AStopOnOneRankEndsBothAtTheNextSharedSums) {
+  auto scene = make_builtin_scene("cornell-glass", 24, 20);
+  IntegratorSettings settings;
+  settings.seed = 7;
+  // Rank 1 asks to stop at the third sums (before probe 3).
+  const PairResult pair = render_on_thread_pair(*scene, "adaptive-vcm", settings, 64, 2);
+  EXPECT_TRUE(pair.interrupted[0]);
+  EXPECT_TRUE(pair.interrupted[1]);
+  EXPECT_EQ(pair.sums, 3);
+  EXPECT_EQ(pair.iterations[0], 2u);  // 0 and 2: iteration 2 comes before probe 3
+  EXPECT_EQ(pair.iterations[1], 1u);  // 1
 }
 
 }  // namespace

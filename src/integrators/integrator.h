@@ -75,6 +75,20 @@ class Integrator {
   // Integrator-specific statistics for the JSON output.
   virtual void report(nlohmann::json& stats) const { (void)stats; }
 
+  // Learning that every MPI rank shares (adaptive-vcm's probes): an iteration for which this is
+  // true teaches the integrator how to render later ones. The render loop has every rank render
+  // it, in global iteration order, so that each rank learns the same; only the rank that owns
+  // the iteration (iteration mod K) keeps its image. In one process nothing changes.
+  virtual bool shared_iteration(uint32_t iteration) const {
+    (void)iteration;
+    return false;
+  }
+  // Called by the render loop right before a shared iteration with the film of every iteration
+  // before it, summed over all ranks (at a fixed --spp; under --time, this rank's own film), so
+  // that what the integrator reads from the film does not depend on the number of ranks. An
+  // integrator driven without the render loop reads its own film instead.
+  virtual void observe_film(const Film& before) { (void)before; }
+
  protected:
   int budget_spp() const { return budget_spp_; }
   double budget_seconds() const { return budget_seconds_; }

@@ -32,7 +32,6 @@ std::vector<IntegratorInfo> make_registry() {
                "vcm that picks its light paths, connections and per-pixel merging while "
                "rendering (efficiency-aware MIS, Grittmann 2022)",
                false, true, true, MisHeuristic::Balance, bidir(BidirAlgorithm::AdaptiveVcm)});
-  r.back().learns_while_rendering = true;
   r.push_back({"guided-pt",
                "path tracing guided by incident radiance learned while rendering (Mueller 2017)",
                true, true, false, MisHeuristic::Power,

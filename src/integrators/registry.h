@@ -30,6 +30,8 @@ struct IntegratorInfo {
   // Learns from its own samples while rendering (path guiding): its image depends on every
   // earlier iteration, so it cannot be split over MPI ranks until the learned structures are
   // merged across ranks (not done yet); the command line refuses it with several ranks.
+  // (adaptive-vcm learns only from shared iterations, which every rank renders:
+  // Integrator::shared_iteration.)
   bool learns_while_rendering = false;
 };
 

@@ -44,6 +44,11 @@ class Ranks {
   // which must be a film of the same size, on rank 0; elsewhere *root_total is untouched.
   virtual void sum_films(const Film& mine, Film* root_total) = 0;
 
+  // Collective, on a channel of its own (it may interleave with progress rounds). Sums every
+  // rank's film into *total on every rank (total: a film of the same size, not `mine`) and
+  // returns whether any rank passed stop = true, so that all ranks stop at one decision.
+  virtual bool all_sum_films(const Film& mine, Film* total, bool stop) = 0;
+
   // Collective. Every rank passes its status (0: ready) and, when it failed, its message. All
   // return the largest status; rank 0 gets in *message the lowest failing rank's message
   // (empty if rank 0 failed itself: it has printed its own).
@@ -68,6 +73,10 @@ class SingleProcess final : public Ranks {
     return true;
   }
   void sum_films(const Film& mine, Film* root_total) override;
+  bool all_sum_films(const Film& mine, Film* total, bool stop) override {
+    sum_films(mine, total);
+    return stop;
+  }
   int agree(int status, const std::string&, std::string* message) override {
     message->clear();
     return status;

@@ -40,9 +40,14 @@ class MpiRanks final : public Ranks {
     MPI_Type_contiguous(int(sizeof(FixedSum)), MPI_BYTE, &fixed_type_);
     MPI_Type_commit(&fixed_type_);
     MPI_Op_create(add_fixed_sums, /*commute=*/1, &fixed_add_);
+    // Shared-learning sums get their own communicator: ranks start progress rounds (non-blocking
+    // collectives on MPI_COMM_WORLD) at different points relative to them, and collectives on
+    // one communicator must be issued in the same order by every rank.
+    MPI_Comm_dup(MPI_COMM_WORLD, &learning_);
   }
   ~MpiRanks() override {
     if (round_pending_) MPI_Wait(&round_, MPI_STATUS_IGNORE);
+    MPI_Comm_free(&learning_);
     MPI_Op_free(&fixed_add_);
     MPI_Type_free(&fixed_type_);
     MPI_Finalize();
@@ -87,8 +92,6 @@ class MpiRanks final : public Ranks {
     const std::span<const FixedSum> send = mine.sums();
     FixedSum* recv = rank_ == 0 ? root_total->sums().data() : nullptr;
     const bool in_place = rank_ == 0 && root_total == &mine;
-    // MPI counts are int: reduce in pieces of 2^26 sums (1 GiB).
-    constexpr size_t kPiece = size_t(1) << 26;
     for (size_t at = 0; at < send.size(); at += kPiece) {
       const int n = int(std::min(kPiece, send.size() - at));
       const void* from = in_place ? MPI_IN_PLACE : static_cast<const void*>(send.data() + at);
@@ -98,6 +101,20 @@ class MpiRanks final : public Ranks {
     uint64_t total[2] = {0, 0};
     MPI_Reduce(counts, total, 2, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
     if (rank_ == 0) root_total->set_counts(uint32_t(total[0]), total[1]);
+  }
+
+  bool all_sum_films(const Film& mine, Film* total, bool stop) override {
+    const std::span<const FixedSum> send = mine.sums();
+    FixedSum* recv = total->sums().data();
+    for (size_t at = 0; at < send.size(); at += kPiece) {
+      const int n = int(std::min(kPiece, send.size() - at));
+      MPI_Allreduce(send.data() + at, recv + at, n, fixed_type_, fixed_add_, learning_);
+    }
+    const uint64_t counts[3] = {mine.iterations(), mine.nonfinite_count(), stop ? 1u : 0u};
+    uint64_t sum[3] = {0, 0, 0};
+    MPI_Allreduce(counts, sum, 3, MPI_UINT64_T, MPI_SUM, learning_);
+    total->set_counts(uint32_t(sum[0]), sum[1]);
+    return sum[2] > 0;
   }
 
   int agree(int status, const std::string& mine, std::string* message) override {
@@ -135,7 +152,10 @@ class MpiRanks final : public Ranks {
   }
 
  private:
+  // MPI counts are int: reduce in pieces of 2^26 sums (1 GiB).
+  static constexpr size_t kPiece = size_t(1) << 26;
   int rank_ = 0, size_ = 1;
+  MPI_Comm learning_ = MPI_COMM_NULL;
   MPI_Datatype fixed_type_;
   MPI_Op fixed_add_;
   MPI_Request round_ = MPI_REQUEST_NULL;

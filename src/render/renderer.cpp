@@ -42,6 +42,18 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
   bool interrupted = false;  // ... because of a stop
   bool stop_all = false;     // a stop was agreed in a round: the same on every rank
   bool round_pending = false;
+  // Shared learning across ranks at a fixed --spp: before each shared iteration the ranks sum
+  // their films (a blocking collective), so a rank may only stop there, together with the
+  // others (`stopping` tells them); under --time every rank learns from its own film.
+  const bool shared_sums = rank_count > 1 && budget.seconds <= 0;
+  uint64_t cursor = 0;    // the next global iteration this rank may render
+  bool ending = false;    // on_iteration asked to end
+  bool stopping = false;  // on the way to the next shared iteration's sums, to stop there
+  auto next_shared = [&](uint64_t from) {
+    uint64_t i = from;
+    while (i < uint64_t(budget.spp) && !integrator.shared_iteration(uint32_t(i))) ++i;
+    return i;
+  };
   RoundState totals;
   double next_checkpoint = callbacks.checkpoint_seconds;
   auto my_state = [&] {
@@ -87,18 +99,50 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
     if (finished) continue;
 
     // Iterations are dealt round-robin by their global index, which keys the random streams and
-    // the merge radius schedule exactly as in one process.
-    const uint64_t iteration = me + uint64_t(done) * rank_count;
+    // the merge radius schedule exactly as in one process. Shared iterations (learning every
+    // rank must see, Integrator::shared_iteration) are rendered by every rank, in global order.
+    while (cursor % rank_count != me && !integrator.shared_iteration(uint32_t(cursor))) ++cursor;
+    const uint64_t iteration = cursor;
     if (budget.spp > 0 && iteration >= uint64_t(budget.spp)) {
       finished = true;
     } else if (budget.seconds > 0 && done > 0 && elapsed() >= budget.seconds) {
       finished = true;
-    } else if (done > 0 && stop_all) {
+    } else if (done > 0 && (stop_all || ending) && !shared_sums) {
       // After the budget checks, so a stop that arrives during the last iteration is not
       // reported as an interruption of a render that was complete anyway.
       finished = interrupted = true;
+    } else if ((stop_all || ending) && shared_sums && !stopping) {
+      // Other ranks may be on their way to the next shared iteration's sums: this rank meets
+      // them there and says it stops (below), or ends now if no shared iteration is left.
+      stopping = true;
+      const uint64_t next = next_shared(iteration);
+      if (next >= uint64_t(budget.spp)) {
+        finished = interrupted = true;
+      } else {
+        cursor = next;
+        continue;
+      }
     }
     if (finished) continue;
+    const bool own = iteration % rank_count == me;
+    if (integrator.shared_iteration(uint32_t(iteration))) {
+      if (shared_sums) {
+        Film before(film.width(), film.height());
+        if (ranks.all_sum_films(film, &before, stopping)) {
+          finished = interrupted = true;
+          continue;
+        }
+        integrator.observe_film(before);
+      } else {
+        integrator.observe_film(film);
+      }
+    }
+    ++cursor;
+    if (!own) {  // someone else's shared iteration: learn from it, keep no image
+      Film scratch(film.width(), film.height());
+      integrator.render_iteration(scene, uint32_t(iteration), scratch);
+      continue;
+    }
     integrator.render_iteration(scene, uint32_t(iteration), film);
     film.end_iteration();
     ++done;
@@ -106,7 +150,8 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
       const auto before = std::chrono::steady_clock::now();
       const bool go_on = callbacks.on_iteration(film, done, elapsed());
       paused += std::chrono::duration<double>(std::chrono::steady_clock::now() - before).count();
-      if (!go_on) finished = true;
+      if (!go_on && !shared_sums) finished = true;
+      if (!go_on) ending = true;
     }
   }
   integrator.finish(scene, film);

@@ -133,6 +133,17 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
   void report(nlohmann::json& stats) const override;
 
+  // adaptive-vcm's probes are shared: every MPI rank renders them, and the means that normalise
+  // their variances come from the film of all ranks (observe_film), so every rank makes the
+  // choice one process makes.
+  bool shared_iteration(uint32_t iteration) const override {
+    return tech_.adaptive && plan_.is_probe(iteration);
+  }
+  void observe_film(const Film& before) override {
+    observed_means_ = pixel_means(before);
+    observed_ = true;
+  }
+
  private:
   bool stores_vertices() const { return tech_.connect || tech_.merge; }
 
@@ -276,6 +287,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
   // every candidate), and so do runs that write technique images.
   std::unique_ptr<PathTracer> path_tracer_;
   uint32_t path_tracing_iterations_ = 0;
+  // The pixel means observe_film() was given for the next probe (else the probe reads its film).
+  std::vector<float> observed_means_;
+  bool observed_ = false;
 };
 
 }  // namespace caustica::bidir

@@ -123,7 +123,9 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   if (it.plan.probe) plan_.begin_probe(it.radius);
   if (path_tracer_ && n == 0 && !it.plan.probe) ++path_tracing_iterations_;
   // Before this iteration adds anything: the film adds estimates to its totals as they come.
-  const std::vector<float> means_before = it.plan.probe ? pixel_means(film) : std::vector<float>();
+  std::vector<float> means_before;
+  if (it.plan.probe) means_before = observed_ ? std::move(observed_means_) : pixel_means(film);
+  observed_ = false;
 
   const auto light_start = std::chrono::steady_clock::now();
   size_chunks(n);

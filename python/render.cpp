@@ -234,24 +234,25 @@ void add_render_functions(py::module_& m) {
       "integrators() -> dict name -> one-line description: the integrators render() and compare() "
       "accept, from the registry, in the order the README documents them.");
 
-  m.def("render", &render_scene, py::arg("scene"), py::arg("integrator") = "vcm",
-        py::arg("spp") = py::none(), py::arg("time") = py::none(), py::arg("seed") = 0,
-        py::arg("threads") = 0,
-        "render(scene, integrator='vcm', spp=None, time=None, seed=0, threads=0, **options)"
-        " -> numpy.ndarray float32 (height, width, 3), linear RGB\n\n"
-        "Renders as `caustica render` does, and with the same settings to the same bits.\n"
-        "spp: iterations (samples per pixel), >= 1; time: seconds, at most 30 days; both: "
-        "whichever ends first; neither: the scene's spp, else 16.\n"
-        "seed: 0..2^64-1. threads: 0..1024, 0 = all cores (the image does not depend on it).\n"
-        "options, as the command line's flags: mis ('balance' or 'power'; default: power for pt, "
-        "balance for the bidirectional family), max_depth (0..255; default: the scene's), "
-        "light_paths (light subpaths per iteration, >= 1; default: one per pixel), radius "
-        "(initial merge radius, > 0; default: from the scene size), radius_alpha (in (0, 1]; "
-        "default 0.75), connections (light subpaths per camera vertex for bpt/vcm, 1..64), "
-        "adaptive_costs ('model' or 'measured', adaptive-vcm). None means not given. Unknown names "
-        "or bad values raise ValueError.\n"
-        "Releases the GIL; Ctrl-C ends the render after its current iteration and raises "
-        "KeyboardInterrupt.");
+  m.def(
+      "render", &render_scene, py::arg("scene"), py::arg("integrator") = "adaptive-vcm",
+      py::arg("spp") = py::none(), py::arg("time") = py::none(), py::arg("seed") = 0,
+      py::arg("threads") = 0,
+      "render(scene, integrator='adaptive-vcm', spp=None, time=None, seed=0, threads=0, **options)"
+      " -> numpy.ndarray float32 (height, width, 3), linear RGB\n\n"
+      "Renders as `caustica render` does, and with the same settings to the same bits.\n"
+      "spp: iterations (samples per pixel), >= 1; time: seconds, at most 30 days; both: "
+      "whichever ends first; neither: the scene's spp, else 16.\n"
+      "seed: 0..2^64-1. threads: 0..1024, 0 = all cores (the image does not depend on it).\n"
+      "options, as the command line's flags: mis ('balance' or 'power'; default: power for pt, "
+      "balance for the bidirectional family), max_depth (0..255; default: the scene's), "
+      "light_paths (light subpaths per iteration, >= 1; default: one per pixel), radius "
+      "(initial merge radius, > 0; default: from the scene size), radius_alpha (in (0, 1]; "
+      "default 0.75), connections (light subpaths per camera vertex for bpt/vcm, 1..64), "
+      "adaptive_costs ('model' or 'measured', adaptive-vcm). None means not given. Unknown names "
+      "or bad values raise ValueError.\n"
+      "Releases the GIL; Ctrl-C ends the render after its current iteration and raises "
+      "KeyboardInterrupt.");
 
   m.def("compare", &compare, py::arg("scene"), py::arg("integrators"), py::arg("time"),
         py::arg("reference") = py::none(), py::arg("threads") = 0, py::arg("seed") = 0,

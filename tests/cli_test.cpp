@@ -24,7 +24,7 @@ TEST(Cli, RenderWritesExrPngAndJsonStatistics) {
   EXPECT_TRUE(fs::exists(d / "out.png"));
   std::ifstream f(d / "out.json");
   const nlohmann::json j = nlohmann::json::parse(f);
-  EXPECT_EQ(j["integrator"], "pt");
+  EXPECT_EQ(j["integrator"], "adaptive-vcm");  // the default without a scene-named one
   EXPECT_EQ(j["spp"], 2);
   EXPECT_EQ(j["resolution"], nlohmann::json({24, 16}));
   EXPECT_EQ(j["seed"], 3);

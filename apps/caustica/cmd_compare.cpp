@@ -138,7 +138,7 @@ void warn_if_reference_shares_seed(const std::string& reference, uint64_t seed) 
 }
 
 struct CompareOptions : SharedOptions {
-  std::string integrators = "pt,bpt,vcm,ppm";
+  std::string integrators = "adaptive-vcm,pt,bpt,vcm,ppm";
   std::string reference;
   std::string out_dir;
   std::string reference_integrator = "";
@@ -316,8 +316,9 @@ Runner add_compare_command(CLI::App& app) {
       "(exit 130 / 143); a second Ctrl-C quits at once.");
   cmd->add_option("scene", o->scene, "Scene name or file")->required();
   add_shared_options(*checks, o.get(), "Seconds per integrator")->required();
-  cmd->add_option("--integrators", o->integrators,
-                  "Comma-separated integrators (default pt,bpt,vcm,ppm) of: " + integrator_help());
+  cmd->add_option(
+      "--integrators", o->integrators,
+      "Comma-separated integrators (default adaptive-vcm,pt,bpt,vcm,ppm) of: " + integrator_help());
   cmd->add_option(
       "--reference", o->reference,
       "Reference image (EXR), the scene's resolution (default: render one first, 4x --time)");

@@ -85,8 +85,8 @@ int run_render(const RenderOptions& o, const CheckedOptions& checks, Ranks& rank
     if (int rc = load_configured_scene(setup, &scene, &settings, &load_seconds)) return rc;
 
     integrator_name = o.integrator;
-    if (integrator_name.empty()) {  // the scene file's (the loader maps pbrt-v4's names), else pt
-      integrator_name = "pt";
+    if (integrator_name.empty()) {       // the scene file's (the loader maps pbrt-v4's names), else
+      integrator_name = "adaptive-vcm";  // the one that picks its techniques for the scene
       for (const auto& n : integrator_names())
         if (n == scene->settings().integrator) integrator_name = n;
     }
@@ -184,7 +184,7 @@ Runner add_render_command(CLI::App& app) {
   cmd->add_option("--scene", opts->scene_flag,
                   "Scene name or file (same as the positional argument)");
   cmd->add_option("--integrator", opts->integrator,
-                  "Integrator (default: the scene's, else pt): " + integrator_help());
+                  "Integrator (default: the scene's, else adaptive-vcm): " + integrator_help());
   checks->integer("--spp", &opts->spp, 1, std::numeric_limits<int>::max(),
                   "Samples (iterations) per pixel, at least 1 (default: the scene's, else 16)");
   add_shared_options(*checks, opts.get(), "Time budget in seconds (iterations until it is spent)");

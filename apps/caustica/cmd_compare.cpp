@@ -50,6 +50,7 @@ struct ReferenceOptions : SharedOptions {
   std::string integrator = "pt";
   std::string outfile;
   double checkpoint_seconds = 60;
+  bool quiet = false;
 };
 
 int run_reference(const ReferenceOptions& o, const CheckedOptions& checks, Ranks& ranks) {
@@ -80,6 +81,7 @@ int run_reference(const ReferenceOptions& o, const CheckedOptions& checks, Ranks
   budget.seconds = o.seconds;
   RenderCallbacks cb;
   cb.progress_label = "reference " + o.integrator;
+  cb.quiet = o.quiet;
   cb.stop = stop_flag();
   cb.ranks = &ranks;
   if (ranks.size() > 1) {
@@ -303,6 +305,7 @@ Runner add_reference_command(CLI::App& app) {
   checks->number("--checkpoint", &o->checkpoint_seconds, 0, kMaxSeconds, false,
                  "Under mpirun with several ranks: every this many seconds combine the ranks' "
                  "images and write the outputs (default 60; 0: only at the end)");
+  cmd->add_flag("--quiet,-q", o->quiet, "No progress bar");
   return [o, checks](Ranks& ranks) { return run_reference(*o, *checks, ranks); };
 }
 

@@ -234,6 +234,9 @@ void add_counts(ProbeWork& total, const ProbeWork& w) {
 
 void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means) {
   ++probes_;
+  // The light-tracing sums (4 bytes per pixel and candidate) are only needed while a probe
+  // renders; released before the choice, so that its buffers do not add to them.
+  std::vector<float>().swap(light_sums_);
   add_counts(work_, w);
   work_.light_seconds += w.light_seconds;
   work_.camera_seconds += w.camera_seconds;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <utility>
 
 namespace caustica {
@@ -43,6 +44,15 @@ GuidingField::GuidingField(Bounds3 bounds, const GuidingSettings& settings, bool
         if (nodes_[i].axis() == SpatialNode::kLeaf) split(i, counts_, 0);
     }
     std::fill(counts_.begin(), counts_.end(), 0);
+    // Each copy's node stays its subtree's root through later splits: descents start there.
+    const Vec3 center = bounds_.center();
+    for (int side = 0; side < 8; ++side) {
+      const Vec3 p = class_point(center, side);
+      uint32_t node = 0;
+      while (nodes_[node].axis() != SpatialNode::kLeaf)
+        node = nodes_[node].index() + (p[int(nodes_[node].axis())] >= nodes_[node].middle);
+      class_root_[size_t(side)] = node;
+    }
   }
   refresh_guides();
 }
@@ -66,14 +76,30 @@ void GuidingField::add_vertex_counts(const std::vector<uint32_t>& counts) {
 }
 
 uint32_t GuidingField::leaf_at(Vec3 p, int side) const {
-  return leaf_of_point(class_point(p, side));
+  return leaf_of_point(class_point(p, side), sided_ ? class_root_[size_t(side)] : 0);
 }
 
-uint32_t GuidingField::leaf_of_point(Vec3 p) const {
+uint32_t GuidingField::leaf_of_point(Vec3 p, uint32_t start) const {
   const float coordinate[4] = {p.x, p.y, p.z, 0};  // indexed without branches
-  SpatialNode n = nodes_[0];
-  while (n.axis() != SpatialNode::kLeaf) n = nodes_[n.index() + (coordinate[n.axis()] >= n.middle)];
-  return n.index();
+  // Both children are loaded while the side is decided (they are adjacent, one cache line), and
+  // the choice is a select, not a branch: a level costs one load's latency, not a load followed
+  // by the comparison that decides the next load's address.
+  static_assert(sizeof(SpatialNode) == sizeof(uint64_t));
+  uint64_t n;
+  std::memcpy(&n, &nodes_[start], sizeof(n));
+  auto axis = [](uint64_t bits) { return uint32_t(bits >> 62); };
+  while (axis(n) != SpatialNode::kLeaf) {
+    float middle;
+    const uint32_t packed = uint32_t(n >> 32);
+    std::memcpy(&middle, &n, sizeof(middle));
+    uint64_t lower, upper;
+    const SpatialNode* children = &nodes_[packed & SpatialNode::kIndexMask];
+    std::memcpy(&lower, children, sizeof(lower));
+    std::memcpy(&upper, children + 1, sizeof(upper));
+    const uint64_t take_upper = uint64_t(0) - uint64_t(coordinate[axis(n)] >= middle);
+    n = (lower & ~take_upper) | (upper & take_upper);
+  }
+  return uint32_t(n >> 32) & SpatialNode::kIndexMask;
 }
 
 void GuidingField::refresh_guides() {

@@ -23,6 +23,7 @@
 // parallel, each leaf's records in that order: the field does not depend on thread scheduling.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -127,7 +128,8 @@ class GuidingField {
   void radix_sort_by_key(std::vector<GuidingRecord>& records, int bits);
   // Splits a leaf node in two at the middle of `axis` (-1: its box's longest axis).
   void split(uint32_t node, std::vector<uint64_t>& counts, int axis = -1);
-  uint32_t leaf_of_point(Vec3 p) const;
+  // The leaf holding p, descending from node `start` (p must lie in its box).
+  uint32_t leaf_of_point(Vec3 p, uint32_t start) const;
   // p clamped into the scene's box along x and moved into the copy of its side class.
   Vec3 class_point(Vec3 p, int side) const;
   void split_leaves(int k);
@@ -137,7 +139,8 @@ class GuidingField {
   Bounds3 bounds_;        // the scene's box (copy 0)
   float copy_width_ = 0;  // sided: the x extent of one copy
   bool sided_ = false;
-  std::vector<SpatialNode> nodes_;  // nodes_[0] is the root
+  std::array<uint32_t, 8> class_root_{};  // sided: the node of each copy (the top 3 levels)
+  std::vector<SpatialNode> nodes_;        // nodes_[0] is the root
   std::vector<Leaf> leaves_;
   std::vector<uint64_t> counts_;        // path vertices per leaf in the current pass
   std::vector<Guide> guides_;           // per leaf

@@ -341,7 +341,7 @@ static void fill_ray(const Ray& r, RTCRay* out) {
 }
 
 bool Scene::occluded(const Ray& ray) const {
-  Impl::RayCounts& counts = impl_->rays.local();
+  Impl::RayCounts& counts = impl_->local_counts();
   ++counts.all;
   ++counts.occlusion;
   RTCIntersectContext ctx;
@@ -353,7 +353,7 @@ bool Scene::occluded(const Ray& ray) const {
 }
 
 bool Scene::intersect(const Ray& ray, SurfaceInteraction* si) const {
-  ++impl_->rays.local().all;
+  ++impl_->local_counts().all;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh;

@@ -10,6 +10,15 @@ namespace {
 constexpr int kMantissaBits = 16;
 constexpr uint64_t kMantissaMask = (1u << kMantissaBits) - 1;
 
+// 2^k as a float, exactly as std::ldexp(1.f, k) gives it (subnormal below 2^-126), without the
+// library call: k in [-149, 127].
+float power_of_two(int k) {
+  return k >= -126 ? std::bit_cast<float>(uint32_t(k + 127) << 23)
+                   : std::bit_cast<float>(uint32_t(1) << (k + 149));
+}
+// std::lround of a value in [0, 2^31), without the library call: in double, x + 0.5 is exact.
+uint32_t round_nonnegative(double x) { return uint32_t(x + 0.5); }
+
 // Shared-exponent RGB: the largest channel keeps 16 significant bits.
 uint64_t encode_throughput(Rgb c) {
   const float m = std::max(c.max_component(), 0.f);
@@ -17,7 +26,11 @@ uint64_t encode_throughput(Rgb c) {
   int e;
   std::frexp(m, &e);  // m = f * 2^e, f in [0.5, 1)
   auto quantise = [&](float v, int exp) {
-    return uint64_t(std::lround(std::max(v, 0.f) * std::ldexp(1.f, kMantissaBits - exp)));
+    // In double: frexp's exponent of a tiny channel makes 2^(16 - exp) too large for a float
+    // (exp down to -148). Scaling by a power of two is exact, so this is the float product
+    // wherever that one exists.
+    const double scale = std::bit_cast<double>(uint64_t(kMantissaBits - exp + 1023) << 52);
+    return uint64_t(round_nonnegative(double(std::max(v, 0.f)) * scale));
   };
   if (quantise(m, e) > kMantissaMask) ++e;  // rounding carried into the next binade
   e = std::clamp(e, -126, 127);
@@ -29,14 +42,14 @@ uint64_t encode_throughput(Rgb c) {
 Rgb decode_throughput(uint64_t bits) {
   const uint32_t exponent = uint32_t(bits & 0xff);
   if (exponent == 0) return Rgb(0.f);
-  const float scale = std::ldexp(1.f, int(exponent) - 128 - kMantissaBits);
+  const float scale = power_of_two(int(exponent) - 128 - kMantissaBits);
   return {float((bits >> 8) & kMantissaMask) * scale,
           float((bits >> (8 + kMantissaBits)) & kMantissaMask) * scale,
           float((bits >> (8 + 2 * kMantissaBits)) & kMantissaMask) * scale};
 }
 
 uint32_t snorm16(float v) {
-  return uint32_t(std::lround((std::clamp(v, -1.f, 1.f) * 0.5f + 0.5f) * 65535.f));
+  return round_nonnegative((std::clamp(v, -1.f, 1.f) * 0.5f + 0.5f) * 65535.f);
 }
 float from_snorm16(uint32_t b) { return float(b) / 65535.f * 2.f - 1.f; }
 

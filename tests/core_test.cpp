@@ -1,7 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+
 #include "core/distribution.h"
 #include "core/frame.h"
+#include "core/math.h"
 #include "core/rng.h"
 #include "core/transform.h"
 #include "core/warp.h"
@@ -144,3 +148,23 @@ TEST(Warp, TriangleSamplesAreUniform) {
   EXPECT_NEAR(b0 / 100000, 1.0 / 3, 0.003);
   EXPECT_NEAR(b1 / 100000, 1.0 / 3, 0.003);
 }
+
+namespace caustica {
+namespace {
+
+TEST(NextFloat, MatchesStdNextafterEverywhere) {
+  const float values[] = {
+      0.f,           -0.f,           1.f,       -1.f,       1e-45f, -1e-45f,   1.17549435e-38f,
+      3.4028235e38f, -3.4028235e38f, kInfinity, -kInfinity, 0.1f,   -123.456f, 7e-40f};
+  for (float v : values) {
+    EXPECT_EQ(std::bit_cast<uint32_t>(next_float_up(v)),
+              std::bit_cast<uint32_t>(std::nextafter(v, kInfinity)))
+        << v;
+    EXPECT_EQ(std::bit_cast<uint32_t>(next_float_down(v)),
+              std::bit_cast<uint32_t>(std::nextafter(v, -kInfinity)))
+        << v;
+  }
+}
+
+}  // namespace
+}  // namespace caustica

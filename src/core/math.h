@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -24,6 +25,21 @@ constexpr T sqr(T v) {
 template <typename T>
 constexpr T clamp(T v, T lo, T hi) {
   return std::min(std::max(v, lo), hi);
+}
+
+// std::nextafter(v, +infinity) and (v, -infinity) without the library call (pbrt-v4's
+// NextFloatUp/Down): the same float for every input, infinities and signed zeros included.
+inline float next_float_up(float v) {
+  if (v == kInfinity) return v;
+  if (v == 0.f) v = 0.f;  // -0 steps to the smallest positive float, as +0 does
+  const uint32_t bits = std::bit_cast<uint32_t>(v);
+  return std::bit_cast<float>(v >= 0 ? bits + 1 : bits - 1);
+}
+inline float next_float_down(float v) {
+  if (v == -kInfinity) return v;
+  if (v == 0.f) v = -0.f;
+  const uint32_t bits = std::bit_cast<uint32_t>(v);
+  return std::bit_cast<float>(v > 0 ? bits - 1 : bits + 1);
 }
 
 inline float lerp(float t, float a, float b) { return (1 - t) * a + t * b; }

@@ -41,9 +41,9 @@ struct SurfaceInteraction {
     Vec3 po = p + offset;
     for (int i = 0; i < 3; ++i) {  // round away from p so the offset is never lost
       if (offset[i] > 0)
-        po[i] = std::nextafter(po[i], kInfinity);
+        po[i] = next_float_up(po[i]);
       else if (offset[i] < 0)
-        po[i] = std::nextafter(po[i], -kInfinity);
+        po[i] = next_float_down(po[i]);
     }
     return po;
   }

@@ -28,12 +28,15 @@ Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pc
     acc.plan = &plan_;
     acc.candidate_sums = plan_.pixel_start(sample.pixel);
   }
-  const auto start = std::chrono::steady_clock::now();
+  // The clock is read only where it is used (a clock read per pixel was 0.6% of vcm's profile).
+  const bool timed = it.plan.probe && settings_.bidir.measured_costs;
+  const auto start =
+      timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
   camera_path(scene, it, sample, rng, acc, arena);
   *nonfinite += acc.nonfinite;
   if (it.plan.probe) {
     plan_.pixel_end(sample.pixel, acc.candidate_sums);
-    if (settings_.bidir.measured_costs) acc.work.camera_seconds = seconds_since(start);
+    if (timed) acc.work.camera_seconds = seconds_since(start);
   }
   add_work(acc.work);
   if (tech_.guided) camera_values_[sample.pixel] = acc.sum * acc.filter_weight;

@@ -235,7 +235,7 @@ void add_render_functions(py::module_& m) {
       "accept, from the registry, in the order the README documents them.");
 
   m.def(
-      "render", &render_scene, py::arg("scene"), py::arg("integrator") = "adaptive-vcm",
+      "render", &render_scene, py::arg("scene"), py::arg("integrator") = kDefaultIntegrator,
       py::arg("spp") = py::none(), py::arg("time") = py::none(), py::arg("seed") = 0,
       py::arg("threads") = 0,
       "render(scene, integrator='adaptive-vcm', spp=None, time=None, seed=0, threads=0, **options)"

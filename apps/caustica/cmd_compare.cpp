@@ -140,7 +140,7 @@ void warn_if_reference_shares_seed(const std::string& reference, uint64_t seed) 
 }
 
 struct CompareOptions : SharedOptions {
-  std::string integrators = "adaptive-vcm,pt,bpt,vcm,ppm";
+  std::string integrators = std::string(kDefaultIntegrator) + ",pt,bpt,vcm,ppm";
   std::string reference;
   std::string out_dir;
   std::string reference_integrator = "";

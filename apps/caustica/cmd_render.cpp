@@ -85,8 +85,8 @@ int run_render(const RenderOptions& o, const CheckedOptions& checks, Ranks& rank
     if (int rc = load_configured_scene(setup, &scene, &settings, &load_seconds)) return rc;
 
     integrator_name = o.integrator;
-    if (integrator_name.empty()) {       // the scene file's (the loader maps pbrt-v4's names), else
-      integrator_name = "adaptive-vcm";  // the one that picks its techniques for the scene
+    if (integrator_name.empty()) {  // the scene file's (the loader maps pbrt-v4's names), else
+      integrator_name = kDefaultIntegrator;
       for (const auto& n : integrator_names())
         if (n == scene->settings().integrator) integrator_name = n;
     }
@@ -184,7 +184,8 @@ Runner add_render_command(CLI::App& app) {
   cmd->add_option("--scene", opts->scene_flag,
                   "Scene name or file (same as the positional argument)");
   cmd->add_option("--integrator", opts->integrator,
-                  "Integrator (default: the scene's, else adaptive-vcm): " + integrator_help());
+                  "Integrator (default: the scene's, else " + std::string(kDefaultIntegrator) +
+                      "): " + integrator_help());
   checks->integer("--spp", &opts->spp, 1, std::numeric_limits<int>::max(),
                   "Samples (iterations) per pixel, at least 1 (default: the scene's, else 16)");
   add_shared_options(*checks, opts.get(), "Time budget in seconds (iterations until it is spent)");
@@ -220,12 +221,16 @@ std::string integrator_help() {
 Runner add_integrators_command(CLI::App& app) {
   app.add_subcommand("integrators", "List the integrators, what each is, and its capabilities");
   return [](Ranks&) {
+    int width = 0;
     for (const IntegratorInfo& info : integrator_registry())
-      std::printf("%-5s %-11s %-15s %-12s %s\n", info.name.c_str(),
+      width = std::max(width, int(info.name.size()));
+    for (const IntegratorInfo& info : integrator_registry())
+      std::printf("%-*s %-11s %-15s %-12s %s%s\n", width, info.name.c_str(),
                   info.unbiased ? "unbiased" : "consistent",
                   info.default_mis == MisHeuristic::Power ? "mis: power" : "mis: balance",
                   info.caustics_through_specular ? "SDS: merges" : "SDS: no",
-                  info.description.c_str());
+                  info.description.c_str(),
+                  info.name == kDefaultIntegrator ? " [the default]" : "");
     return 0;
   };
 }

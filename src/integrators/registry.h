@@ -35,6 +35,10 @@ struct IntegratorInfo {
   bool learns_while_rendering = false;
 };
 
+// What `caustica render` and Python's render() use when neither the user nor the scene file
+// names an integrator, and compare's first column: the one that picks its techniques per scene.
+inline constexpr const char* kDefaultIntegrator = "adaptive-vcm";
+
 // In the order the README documents them.
 const std::vector<IntegratorInfo>& integrator_registry();
 // nullptr for an unknown name.

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "film/film.h"
+#include "render/iteration_dealer.h"
 #include "render/progress.h"
 #include "render/ranks.h"
 #include "scene/scene.h"
@@ -46,13 +47,20 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
   // their films (a blocking collective), so a rank may only stop there, together with the
   // others (`stopping` tells them); under --time every rank learns from its own film.
   const bool shared_sums = rank_count > 1 && budget.seconds <= 0;
-  uint64_t cursor = 0;    // the next global iteration this rank may render
+  IterationDealer dealer(integrator, me, rank_count, budget.spp);
   bool ending = false;    // on_iteration asked to end
   bool stopping = false;  // on the way to the next shared iteration's sums, to stop there
-  auto next_shared = [&](uint64_t from) {
-    uint64_t i = from;
-    while (i < uint64_t(budget.spp) && !integrator.shared_iteration(uint32_t(i))) ++i;
-    return i;
+  // Before a shared iteration: the film of every iteration before it, over all ranks. False
+  // when the ranks agreed there to stop.
+  auto observe_before = [&] {
+    if (!shared_sums) {
+      integrator.observe_film(film);
+      return true;
+    }
+    Film before(film.width(), film.height());
+    if (ranks.all_sum_films(film, &before, stopping)) return false;
+    integrator.observe_film(before);
+    return true;
   };
   RoundState totals;
   double next_checkpoint = callbacks.checkpoint_seconds;
@@ -98,11 +106,7 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
     }
     if (finished) continue;
 
-    // Iterations are dealt round-robin by their global index, which keys the random streams and
-    // the merge radius schedule exactly as in one process. Shared iterations (learning every
-    // rank must see, Integrator::shared_iteration) are rendered by every rank, in global order.
-    while (cursor % rank_count != me && !integrator.shared_iteration(uint32_t(cursor))) ++cursor;
-    const uint64_t iteration = cursor;
+    const uint64_t iteration = dealer.current();  // iteration_dealer.h
     if (budget.spp > 0 && iteration >= uint64_t(budget.spp)) {
       finished = true;
     } else if (budget.seconds > 0 && done > 0 && elapsed() >= budget.seconds) {
@@ -115,30 +119,16 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
       // Other ranks may be on their way to the next shared iteration's sums: this rank meets
       // them there and says it stops (below), or ends now if no shared iteration is left.
       stopping = true;
-      const uint64_t next = next_shared(iteration);
-      if (next >= uint64_t(budget.spp)) {
-        finished = interrupted = true;
-      } else {
-        cursor = next;
-        continue;
-      }
+      if (dealer.skip_to_next_shared()) continue;
+      finished = interrupted = true;
     }
     if (finished) continue;
-    const bool own = iteration % rank_count == me;
-    if (integrator.shared_iteration(uint32_t(iteration))) {
-      if (shared_sums) {
-        Film before(film.width(), film.height());
-        if (ranks.all_sum_films(film, &before, stopping)) {
-          finished = interrupted = true;
-          continue;
-        }
-        integrator.observe_film(before);
-      } else {
-        integrator.observe_film(film);
-      }
+    if (dealer.shared(iteration) && !observe_before()) {
+      finished = interrupted = true;
+      continue;
     }
-    ++cursor;
-    if (!own) {  // someone else's shared iteration: learn from it, keep no image
+    dealer.advance();
+    if (!dealer.owns(iteration)) {  // someone else's shared iteration: learn, keep no image
       Film scratch(film.width(), film.height());
       integrator.render_iteration(scene, uint32_t(iteration), scratch);
       continue;

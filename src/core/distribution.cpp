@@ -30,10 +30,16 @@ Distribution1D::Distribution1D(std::vector<float> weights) : func_(std::move(wei
 }
 
 static size_t find_interval(const std::vector<float>& cdf, float u) {
-  // Largest i with cdf[i] <= u, clamped to [0, n-1]; skips zero-width buckets.
-  auto it = std::upper_bound(cdf.begin(), cdf.end(), u);
-  size_t i = size_t(std::max<std::ptrdiff_t>(0, (it - cdf.begin()) - 1));
-  return std::min(i, cdf.size() - 2);
+  // Largest i with cdf[i] <= u, clamped to [0, n-1] (cdf[0] = 0). A binary search whose steps
+  // are selects, not branches: the same index as std::upper_bound minus one for any u >= 0,
+  // without a mispredicted branch per halving (it runs for every camera ray's filter sample).
+  size_t lo = 0, len = cdf.size();
+  while (len > 1) {
+    const size_t half = len / 2;
+    lo = cdf[lo + half] <= u ? lo + half : lo;
+    len -= half;
+  }
+  return std::min(lo, cdf.size() - 2);
 }
 
 size_t Distribution1D::sample_discrete(float u, float* pmf_out, float* remapped) const {

@@ -85,22 +85,17 @@ TEST(FilmSum, RejectsAFilmOfAnotherSize) {
   EXPECT_THROW(a.add(b), std::invalid_argument);
 }
 
-// Rank `rank` of `size`, alone: its rounds report that the others finish when it does, and
-// its film goes to the test instead of a reduction.
-class PretendRank final : public Ranks {
+// What the pretend ranks below share: progress rounds report that the other ranks finish when
+// this one does, and the ranks agree on this rank's own status.
+class LoneRounds : public Ranks {
  public:
-  PretendRank(int rank, int size, Film* film_out) : rank_(rank), size_(size), out_(film_out) {}
+  LoneRounds(int rank, int size) : rank_(rank), size_(size) {}
   int rank() const override { return rank_; }
   int size() const override { return size_; }
   void start_round(const RoundState& mine) override { round_ = mine; }
   bool poll_round(RoundState* totals, bool) override {
     *totals = round_;
     totals->finished *= uint64_t(size_);
-    return true;
-  }
-  void sum_films(const Film& mine, Film*) override { out_->add(mine); }
-  bool all_sum_films(const Film&, Film*, bool) override {
-    ADD_FAILURE() << "a lone pretend rank cannot sum films with the others";
     return true;
   }
   int agree(int status, const std::string&, std::string* message) override {
@@ -110,10 +105,25 @@ class PretendRank final : public Ranks {
   void wait_all() override {}
   [[noreturn]] void abort(int code) override { std::_Exit(code); }
 
- private:
+ protected:
   int rank_, size_;
-  Film* out_;
+
+ private:
   RoundState round_;
+};
+
+// Rank `rank` of `size`, alone: its film goes to the test instead of a reduction.
+class PretendRank final : public LoneRounds {
+ public:
+  PretendRank(int rank, int size, Film* film_out) : LoneRounds(rank, size), out_(film_out) {}
+  void sum_films(const Film& mine, Film*) override { out_->add(mine); }
+  bool all_sum_films(const Film&, Film*, bool) override {
+    ADD_FAILURE() << "a lone pretend rank cannot sum films with the others";
+    return true;
+  }
+
+ private:
+  Film* out_;
 };
 
 TEST(RanksRender, TwoRanksIterationsGiveTheOneProcessImageBitForBit) {
@@ -158,18 +168,10 @@ struct ThreadPair {
   int sums = 0;  // shared sums made (rank 0 counts)
 };
 
-class ThreadRank final : public Ranks {
+class ThreadRank final : public LoneRounds {
  public:
   ThreadRank(int rank, ThreadPair* pair, int stop_at_sum = -1)
-      : rank_(rank), pair_(pair), stop_at_sum_(stop_at_sum) {}
-  int rank() const override { return rank_; }
-  int size() const override { return 2; }
-  void start_round(const RoundState& mine) override { round_ = mine; }
-  bool poll_round(RoundState* totals, bool) override {
-    *totals = round_;
-    totals->finished *= 2;
-    return true;
-  }
+      : LoneRounds(rank, 2), pair_(pair), stop_at_sum_(stop_at_sum) {}
   void sum_films(const Film& mine, Film*) override {
     const std::lock_guard<std::mutex> lock(pair_->total_mutex);
     pair_->total.add(mine);
@@ -188,19 +190,11 @@ class ThreadRank final : public Ranks {
     pair_->meet.arrive_and_wait();  // both have read before either renders on
     return any;
   }
-  int agree(int status, const std::string&, std::string* message) override {
-    message->clear();
-    return status;
-  }
-  void wait_all() override {}
-  [[noreturn]] void abort(int code) override { std::_Exit(code); }
 
  private:
-  int rank_;
   ThreadPair* pair_;
   int stop_at_sum_;
   int sums_ = 0;
-  RoundState round_;
 };
 
 // Renders `spp` iterations of `name` on two thread ranks; the sum of their films.

@@ -155,9 +155,9 @@ TEST(RanksRender, TwoRanksIterationsGiveTheOneProcessImageBitForBit) {
 }
 
 // Two ranks as two threads of this process, for what needs the ranks to meet: all_sum_films
-// is a real sum over both (a barrier on each side of it), while progress rounds report, as
-// PretendRank's, that the other rank finishes when this one does. stop_from: the shared
-// iteration sums from which on rank 1 asks to stop (none by default).
+// is a real sum over both (a barrier on each side of it), while progress rounds are
+// LoneRounds'. A ThreadRank's stop_at_sum: the shared sums (counted from 0) at which it asks
+// to stop (-1: never).
 struct ThreadPair {
   explicit ThreadPair(int width, int height) : meet(2), total(width, height) {}
   std::barrier<> meet;

@@ -197,15 +197,19 @@ std::string bench_table(const nlohmann::json& result) {
       result["build"]["build_type"].get<std::string>().c_str(),
       result["build"]["commit"].get<std::string>().c_str(), result["settings"]["runs"].get<int>());
   text += line;
-  std::snprintf(line, sizeof line, "%-16s %-5s %3s %10s %9s %9s %9s %7s %8s %8s %8s %8s\n", "scene",
-                "integ", "thr", "ms/iter", "Mrays/s", "Membree", "Mpaths/s", "ratio", "speedup",
-                "peak MB", "+MB", "grid ms");
+  // The integrator column is as wide as the longest name measured (adaptive-vcm, guided-pt).
+  int width = 10;
+  for (const auto& row : result["results"])
+    width = std::max(width, int(row["integrator"].get<std::string>().size()));
+  std::snprintf(line, sizeof line, "%-16s %-*s %3s %10s %9s %9s %9s %7s %8s %8s %8s %8s\n", "scene",
+                width, "integrator", "thr", "ms/iter", "Mrays/s", "Membree", "Mpaths/s", "ratio",
+                "speedup", "peak MB", "+MB", "grid ms");
   text += line;
   for (const auto& row : result["results"])
     for (const auto& c : row["per_thread_count"]) {
       std::snprintf(line, sizeof line,
-                    "%-16s %-5s %3d %10.2f %9.2f %9.2f %9.3f %7.3f %8.2f %8.1f %8.1f %8.2f\n",
-                    row["scene"].get<std::string>().c_str(),
+                    "%-16s %-*s %3d %10.2f %9.2f %9.2f %9.3f %7.3f %8.2f %8.1f %8.1f %8.2f\n",
+                    row["scene"].get<std::string>().c_str(), width,
                     row["integrator"].get<std::string>().c_str(), c["threads"].get<int>(),
                     c["ms_per_iteration"].get<double>(), c["rays_per_second"].get<double>() * 1e-6,
                     c["embree_bound_rays_per_second"].get<double>() * 1e-6,

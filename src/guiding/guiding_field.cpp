@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <utility>
 
@@ -84,7 +85,9 @@ uint32_t GuidingField::leaf_of_point(Vec3 p, uint32_t start) const {
   // Both children are loaded while the side is decided (they are adjacent, one cache line), and
   // the choice is a select, not a branch: a level costs one load's latency, not a load followed
   // by the comparison that decides the next load's address.
-  static_assert(sizeof(SpatialNode) == sizeof(uint64_t));
+  // A node read as one 64-bit word (little endian): `middle` in the low half, `packed` above.
+  static_assert(sizeof(SpatialNode) == sizeof(uint64_t) && offsetof(SpatialNode, middle) == 0 &&
+                offsetof(SpatialNode, packed) == 4);
   uint64_t n;
   std::memcpy(&n, &nodes_[start], sizeof(n));
   auto axis = [](uint64_t bits) { return uint32_t(bits >> 62); };

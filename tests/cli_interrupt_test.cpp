@@ -1,6 +1,8 @@
 // Ctrl-C and SIGTERM as a user meets them: the first signal finishes the current iteration and
 // writes the image so far (JSON "interrupted": true), exit 130 / 143; a second signal quits at
 // once; no temporary file is ever left behind, even when the signal arrives during a write.
+// The renders name `pt`: the timings below assume its short iterations (the default,
+// adaptive-vcm, spends its first iteration on a full VCM probe, minutes at 1024x1024 under ASan).
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -141,8 +143,8 @@ void expect_interrupted_outputs(const fs::path& d, const std::string& stem, int 
 
 TEST(CliInterrupt, SigintDuringRenderWritesTheImageSoFarAndExits130) {
   const fs::path d = cli_test::fresh_dir("sigint_render");
-  Child c({"render", "cornell", "--time", "30", "--resolution", "16x12", "--threads", "1",
-           "--outfile", "out"},
+  Child c({"render", "cornell", "--integrator", "pt", "--time", "30", "--resolution", "16x12",
+           "--threads", "1", "--outfile", "out"},
           d);
   ASSERT_TRUE(c.started());
   ASSERT_TRUE(c.wait_until([&] { return rendering(c); }, 30s)) << c.stderr_text();
@@ -167,9 +169,10 @@ TEST(CliInterrupt, SigtermDuringReferenceWritesTheImageSoFarAndExits143) {
 // microseconds must still be a graceful stop, not the "second Ctrl-C" that quits at once.
 TEST(CliInterrupt, TimeoutCommandStopsGracefully) {
   const fs::path d = cli_test::fresh_dir("timeout");
-  Child c({"--preserve-status", "-s", "INT", "3", CAUSTICA_BINARY, "render", "cornell", "--time",
-           "30", "--resolution", "256x256", "--threads", "1", "--outfile", "out"},
-          d, "timeout");
+  Child c(
+      {"--preserve-status", "-s", "INT", "3", CAUSTICA_BINARY, "render", "cornell", "--integrator",
+       "pt", "--time", "30", "--resolution", "256x256", "--threads", "1", "--outfile", "out"},
+      d, "timeout");
   ASSERT_TRUE(c.started());
   EXPECT_EQ(c.wait_exit(30s), 130) << c.stderr_text();
   expect_interrupted_outputs(d, "out", 256, 256);
@@ -181,8 +184,8 @@ TEST(CliInterrupt, TimeoutCommandStopsGracefully) {
 // quit without writing.
 TEST(CliInterrupt, TwoSignalsMillisecondsApartAreOneRequest) {
   const fs::path d = cli_test::fresh_dir("sigint_duplicate");
-  Child c({"render", "cornell", "--time", "30", "--resolution", "256x256", "--threads", "1",
-           "--outfile", "out"},
+  Child c({"render", "cornell", "--integrator", "pt", "--time", "30", "--resolution", "256x256",
+           "--threads", "1", "--outfile", "out"},
           d);
   ASSERT_TRUE(c.started());
   ASSERT_TRUE(c.wait_until([&] { return rendering(c); }, 30s)) << c.stderr_text();
@@ -197,8 +200,8 @@ TEST(CliInterrupt, SecondSigintQuitsAtOnceWithoutWriting) {
   const fs::path d = cli_test::fresh_dir("sigint_twice");
   // One thread at 1024x1024: an iteration takes about a second, far longer than the 0.2 s
   // between the two signals, so the second one lands inside the iteration.
-  Child c({"render", "cornell", "--time", "60", "--resolution", "1024x1024", "--threads", "1",
-           "--outfile", "out"},
+  Child c({"render", "cornell", "--integrator", "pt", "--time", "60", "--resolution", "1024x1024",
+           "--threads", "1", "--outfile", "out"},
           d);
   ASSERT_TRUE(c.started());
   ASSERT_TRUE(c.wait_until([&] { return rendering(c); }, 60s)) << c.stderr_text();
@@ -220,8 +223,8 @@ TEST(CliInterrupt, SecondSigintQuitsAtOnceWithoutWriting) {
 TEST(CliInterrupt, SecondSignalWhileWritingLeavesNoTemporaryFile) {
   for (int attempt = 0; attempt < 3; ++attempt) {
     const fs::path d = cli_test::fresh_dir("sigint_writing");
-    Child c({"render", "cornell", "--time", "60", "--resolution", "1024x1024", "--threads", "1",
-             "--outfile", "out"},
+    Child c({"render", "cornell", "--integrator", "pt", "--time", "60", "--resolution", "1024x1024",
+             "--threads", "1", "--outfile", "out"},
             d);
     ASSERT_TRUE(c.started());
     ASSERT_TRUE(c.wait_until([&] { return rendering(c); }, 60s)) << c.stderr_text();

@@ -30,7 +30,8 @@
 // subpaths; the cost model prices their camera vertices separately.
 // Every iteration, probe or not, is an unbiased (consistent, when merging) estimate of the
 // same image, and the film averages them. Deterministic at fixed spp and seed for any thread
-// count unless measured costs are asked for; one process only (learns while rendering).
+// count unless measured costs are asked for, and for any number of MPI ranks: every rank renders
+// every probe, normalised by the film of all ranks (Integrator::shared_iteration).
 #pragma once
 
 #include <array>

@@ -30,9 +30,10 @@ class IterationDealer {
   // Moves to the next shared iteration within the --spp budget (this one, if it is shared);
   // false, without moving, when there is none.
   bool skip_to_next_shared() {
+    if (spp_ <= 0) return false;
     uint64_t i = cursor_;
     while (i < uint64_t(spp_) && !shared(i)) ++i;
-    if (spp_ <= 0 || i >= uint64_t(spp_)) return false;
+    if (i >= uint64_t(spp_)) return false;
     cursor_ = i;
     return true;
   }

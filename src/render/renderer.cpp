@@ -48,7 +48,7 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
   // others (`stopping` tells them); under --time every rank learns from its own film.
   const bool shared_sums = rank_count > 1 && budget.seconds <= 0;
   IterationDealer dealer(integrator, me, rank_count, budget.spp);
-  bool ending = false;    // on_iteration asked to end
+  bool ending = false;    // on_iteration asked to end (with shared sums: at the next ones)
   bool stopping = false;  // on the way to the next shared iteration's sums, to stop there
   // Before a shared iteration: the film of every iteration before it, over all ranks. False
   // when the ranks agreed there to stop.
@@ -111,7 +111,7 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
       finished = true;
     } else if (budget.seconds > 0 && done > 0 && elapsed() >= budget.seconds) {
       finished = true;
-    } else if (done > 0 && (stop_all || ending) && !shared_sums) {
+    } else if (done > 0 && stop_all && !shared_sums) {
       // After the budget checks, so a stop that arrives during the last iteration is not
       // reported as an interruption of a render that was complete anyway.
       finished = interrupted = true;
@@ -140,8 +140,8 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
       const auto before = std::chrono::steady_clock::now();
       const bool go_on = callbacks.on_iteration(film, done, elapsed());
       paused += std::chrono::duration<double>(std::chrono::steady_clock::now() - before).count();
+      if (!go_on && shared_sums) ending = true;  // other ranks may be on their way to sums
       if (!go_on && !shared_sums) finished = true;
-      if (!go_on) ending = true;
     }
   }
   integrator.finish(scene, film);

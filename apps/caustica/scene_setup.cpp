@@ -27,6 +27,10 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
   o.choice("--guiding-filter", &s->guiding_filter, {"on", "off"},
            "Guiding: box-filtered splatting into the spatial and directional trees, on or off "
            "(default on)");
+  o.choice("--guiding-target", &s->guiding_target, {"cosine", "radiance"},
+           "Guiding: what the directional distributions learn, incident radiance times the "
+           "cosine to the surface (a product with the cosine) or radiance alone as Mueller 2017 "
+           "(default cosine)");
   o.choice("--guiding-combine", &s->guiding_combine, {"inverse-variance", "equal"},
            "Guiding: weight the training passes in the image by inverse variance, or every "
            "iteration equally (default inverse-variance)");
@@ -119,6 +123,7 @@ int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene,
   settings->guiding = s.guiding;
   settings->guiding.max_bytes = size_t(s.guiding_max_mb) << 20;
   settings->guiding.filter = s.guiding_filter == "on";
+  settings->guiding.cosine_product = s.guiding_target == "cosine";
   settings->guiding.inverse_variance = s.guiding_combine == "inverse-variance";
   return 0;
 }

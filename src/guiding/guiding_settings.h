@@ -32,6 +32,11 @@ struct GuidingSettings {
   // The probability of sampling the BSDF rather than the learned distribution: learned per
   // spatial leaf by Adam on the KL divergence gradient (Müller 2019) when negative, else fixed.
   float bsdf_fraction = -1;
+  // What the directional distributions learn: the incident radiance (Mueller et al. 2017), or
+  // the incident radiance times |cos| to the vertex's shading normal. The latter is the product
+  // with the cosine at no cost: a leaf's points share a side class, so their normals are alike,
+  // and on a diffuse surface it is the product with the whole BSDF.
+  bool cosine_product = true;
   // Rendering passes enter the image weighted by their inverse variance (Müller 2019); false:
   // every iteration with equal weight.
   bool inverse_variance = true;

@@ -36,6 +36,12 @@ struct Mixture {
   float bsdf_fraction = 1;
   uint32_t record_leaf = 0;  // where this vertex's records go (the spatial filter's jitter)
   bool guidable = false;     // records are learned here
+  // The records' weight along wi: |cos| to the shading normal where the guides learn the
+  // product with the cosine (GuidingSettings::cosine_product), else 1.
+  Vec3 cosine_normal;
+  float record_weight(Vec3 wi) const {
+    return cosine_normal == Vec3() ? 1.f : std::abs(dot(cosine_normal, wi));
+  }
 
   DirectionPdfs evaluate(const Bsdf& bsdf, Vec3 wo, Vec3 wi) const {
     DirectionPdfs d;
@@ -97,8 +103,8 @@ std::optional<MixtureSample> sample_mixture(const Bsdf& bsdf, Vec3 wo, const Mix
 // and is not stochastic, with the distribution and selection probability of p's leaf on the
 // side the path arrived from (GuidingField::side_class of the geometric normal facing wo); its
 // records go to the leaf of p jittered by the leaf's size (the spatial box filter).
-Mixture mixture_at(const GuidingField& field, bool filter, const SurfaceInteraction& si,
-                   const Bsdf& bsdf, Pcg32& rng) {
+Mixture mixture_at(const GuidingField& field, const GuidingSettings& settings, bool learn,
+                   const SurfaceInteraction& si, const Bsdf& bsdf, Pcg32& rng) {
   Mixture mix;
   mix.guidable = !is_specular(bsdf.flags()) && !bsdf.is_delta() && !bsdf.stochastic();
   if (!mix.guidable) return mix;
@@ -111,7 +117,9 @@ Mixture mixture_at(const GuidingField& field, bool filter, const SurfaceInteract
     mix.bsdf_fraction = guide.bsdf_fraction;
   }
   mix.record_leaf = leaf;
-  if (filter) {
+  if (!learn) return mix;
+  if (settings.cosine_product) mix.cosine_normal = si.shading.n;
+  if (settings.filter) {
     const float ux = rng.next_float(), uy = rng.next_float(), uz = rng.next_float();
     mix.record_leaf = field.jittered_leaf(p, leaf, Vec3(ux, uy, uz), side);
   }
@@ -121,7 +129,7 @@ Mixture mixture_at(const GuidingField& field, bool filter, const SurfaceInteract
 // A guided vertex whose incident radiance along wi is recorded once the path is done.
 struct GuidedVertex {
   GuidingRecord record;  // radiance and product filled in at the end
-  float pdf;             // the density wi was sampled with
+  float per_pdf;         // the record's weight along wi over the density wi was sampled with
   Rgb weight;            // f |cos| / pdf
   Rgb beta_after;        // path throughput including this vertex's weight
   Rgb incident;          // estimate of the radiance arriving along wi (Müller et al. 2017)
@@ -149,7 +157,7 @@ class PathLearning {
   }
   void add_vertex(const Mixture& m, const MixtureSample& s, Rgb beta_after) {
     GuidingRecord r = base_record(m, s.pdfs);
-    vertices_[count_++] = {r, s.pdf, s.weight, beta_after, Rgb(0.f)};
+    vertices_[count_++] = {r, m.record_weight(s.wi) / s.pdf, s.weight, beta_after, Rgb(0.f)};
   }
   // The next event sample's radiance times its MIS weight over the light density: the light
   // technique's share of the incident radiance's flux estimate.
@@ -160,17 +168,17 @@ class PathLearning {
     // direction sampling's own MIS-weighted share.
     r.guide_pdf = 0;
     const float scale = weight_ * seen.weight / seen.light_pdf;
-    r.radiance = seen.Li.luminance() * scale;
+    r.radiance = seen.Li.luminance() * scale * m.record_weight(seen.wi);
     r.product = (seen.f * seen.Li).luminance() * scale;
     r.statistical_weight = 0;
     if (r.radiance > 0 && std::isfinite(r.radiance)) records_.push_back(r);
   }
-  // Müller et al. 2017, sec. 3.2: each vertex splats L_i / pdf, an estimate of the flux
-  // through the quadrant it lands in.
+  // Müller et al. 2017, sec. 3.2: each vertex splats L_i / pdf (times |cos| where the guides
+  // learn the product with the cosine), an estimate of the flux through the quadrant it lands in.
   void finish() {
     for (int j = 0; j < count_; ++j) {
       GuidedVertex& v = vertices_[j];
-      v.record.radiance = weight_ * v.incident.luminance() / v.pdf;
+      v.record.radiance = weight_ * v.incident.luminance() * v.per_pdf;
       v.record.product = weight_ * (v.weight * v.incident).luminance();
       if (v.record.radiance > 0 && std::isfinite(v.record.radiance)) records_.push_back(v.record);
     }
@@ -309,7 +317,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     if (depth++ == settings_.max_depth) break;
 
     const Vec3 wo = si.wo;
-    const Mixture mix = mixture_at(field_, learn && settings_.guiding.filter, si, bsdf, rng);
+    const Mixture mix = mixture_at(field_, settings_.guiding, learn, si, bsdf, rng);
     // Next event estimation asks for the mixture density toward the light (not for a delta
     // light); what it evaluated is kept for the record.
     DirectionPdfs nee_pdfs;

@@ -18,7 +18,7 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
            "(default c = 4000 for guided-pt, 12000 for guided-bpt/vcm as Mueller 2017)");
   o.number("--guiding-rho", &s->guiding.rho, 0, 1, true,
            "Guiding: refine a directional quadrant holding more than this share of the energy "
-           "(default 0.01)");
+           "(default 0.05 for guided-pt, 0.01 for guided-bpt/vcm as Mueller 2017)");
   o.integer("--guiding-max-mb", &s->guiding_max_mb, 1, 65536,
             "Guiding: memory cap of the learned structure in MiB (default 32)");
   o.number("--guiding-bsdf-fraction", &s->guiding.bsdf_fraction, 0, 1, true,

@@ -268,7 +268,8 @@ void GuidingField::end_pass(int k) {
                       ? (settings_.max_bytes - bytes) / DirectionalQuadtree::kNodeBytes
                       : 0;
   for (Leaf& l : leaves_) {
-    l.recording = l.sampling.refined(settings_.rho, settings_.max_quadtree_depth, &budget);
+    l.recording = l.sampling.refined(settings_.rho_or(GuidingSettings::kMuellerRho),
+                                     settings_.max_quadtree_depth, &budget);
     l.recording.shrink_to_fit();
   }
   counts_.assign(leaves_.size(), 0);

@@ -208,6 +208,7 @@ void GuidedPathTracer::prepare(const Scene& scene, Film& film) {
   CameraPathIntegrator::prepare(scene, film);
   GuidingSettings guiding = settings_.guiding;
   guiding.spatial_threshold = guiding.threshold_or(GuidingSettings::kGuidedPtThreshold);
+  guiding.rho = guiding.rho_or(GuidingSettings::kGuidedPtRho);
   field_ = GuidingField(scene.bounds(), guiding, /*sided=*/true);
   passes_ = InverseVarianceCombiner(scene.camera().width(), scene.camera().height());
   schedule_ = TrainingSchedule(budget_spp(), budget_seconds());

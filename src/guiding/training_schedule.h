@@ -86,11 +86,6 @@ class TrainingSchedule {
   static constexpr size_t kFirstVarianceStop = 5;  // the variance rule from training pass 5 on
   static constexpr uint32_t kMinTrial = 8;         // iterations per trial pass, at least
   static constexpr size_t kEarlyTrialAfter = 3;    // time budgets: the first trial
-  // The early trial switches guiding off only if the unguided pass was this much more
-  // efficient: on door-ajar (where guiding wins 1.5x in the end) it measured guided 2.13
-  // against unguided 2.20 once unguided passes ran pt's own estimator; on the Cornell boxes
-  // unguided won by 12-25%.
-  static constexpr double kEarlyTrialMargin = 1.1;
   void stop_training(const char* reason);
   void train_on();  // the next training pass
 

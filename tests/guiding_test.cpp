@@ -169,6 +169,54 @@ TEST(Guiding, SpatialTreeSeparatesRegions) {
   EXPECT_GT(b.pdf(right.axis), 20 * b.pdf(left.axis));
 }
 
+// leaf_at() starts its descent at a cell of the start grid: it must still find the leaf whose
+// box holds the point, for points anywhere (on split planes, where the descent goes to the upper
+// side; outside the box, which go to the nearest leaf), in a tree of many unequal leaves.
+TEST(Guiding, LeafAtFindsTheLeafWhoseBoxHoldsThePoint) {
+  GuidingSettings s;
+  s.spatial_threshold = 300;
+  const Bounds3 root{{-1.3f, 0.1f, 2}, {2.9f, 1.07f, 2.53f}};  // not dyadic: planes round
+  GuidingField field(root, s);
+  Pcg32 rng(5, 3);
+  // Vertex counts concentrated at one corner: leaves there are far deeper than a grid cell.
+  for (int k = 0; k < 4; ++k) {
+    std::vector<uint32_t> counts(field.leaf_count(), 0);
+    for (int i = 0; i < 40000; ++i) {
+      const float scale = rng.next_float() < 0.9f ? 1e-4f : 1.f;
+      const Vec3 u(rng.next_float(), rng.next_float(), rng.next_float());
+      const Vec3 p = root.lo + (root.hi - root.lo) * u * scale;
+      ++counts[field.leaf_at(p)];
+    }
+    field.add_vertex_counts(counts);
+    field.end_pass(k);
+  }
+  ASSERT_GT(field.leaf_count(), 50u);
+  auto holds = [&](uint32_t leaf, Vec3 p) {
+    const Bounds3& b = field.leaf_box(leaf);
+    for (int a = 0; a < 3; ++a) {
+      const float q = std::clamp(p[a], root.lo[a], root.hi[a]);
+      if (!(b.lo[a] <= q && (q < b.hi[a] || b.hi[a] == root.hi[a]))) return false;
+    }
+    return true;
+  };
+  int wrong = 0;
+  for (int i = 0; i < 200000; ++i) {
+    Vec3 p;
+    if (i % 2) {  // anywhere, up to half the box beyond it
+      const Vec3 u(rng.next_float(), rng.next_float(), rng.next_float());
+      p = root.lo + (root.hi - root.lo) * (u * 2.f - Vec3(0.5f, 0.5f, 0.5f));
+    } else {  // on a plane of some leaf's box
+      const Bounds3& b = field.leaf_box(rng.next_bounded(uint32_t(field.leaf_count())));
+      const Vec3 u(rng.next_float(), rng.next_float(), rng.next_float());
+      p = b.lo + (b.hi - b.lo) * u;
+      const int a = int(rng.next_bounded(3));
+      p[a] = rng.next_float() < 0.5f ? b.lo[a] : b.hi[a];
+    }
+    if (!holds(field.leaf_at(p), p)) ++wrong;
+  }
+  EXPECT_EQ(wrong, 0);
+}
+
 // A sided field learns the two faces of a zero-thickness wall separately: radiance recorded on
 // the +x face (class 0) from +x and on the -x face (class 1) from -x, at the same points, gives
 // each face its own distribution, and a point outside the box still stays in its class.

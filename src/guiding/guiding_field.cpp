@@ -45,17 +45,74 @@ GuidingField::GuidingField(Bounds3 bounds, const GuidingSettings& settings, bool
         if (nodes_[i].axis() == SpatialNode::kLeaf) split(i, counts_, 0);
     }
     std::fill(counts_.begin(), counts_.end(), 0);
-    // Each copy's node stays its subtree's root through later splits: descents start there.
-    const Vec3 center = bounds_.center();
-    for (int side = 0; side < 8; ++side) {
-      const Vec3 p = class_point(center, side);
-      uint32_t node = 0;
-      while (nodes_[node].axis() != SpatialNode::kLeaf)
-        node = nodes_[node].index() + (p[int(nodes_[node].axis())] >= nodes_[node].middle);
-      class_root_[size_t(side)] = node;
-    }
   }
+  // Dyadic cells over the root box, about cubic: double the grid along the axis of the longest
+  // cell extent (as split() halves a box's longest axis) while the cell budget allows.
+  const Vec3 d = sided_ ? Vec3(8 * copy_width_, bounds_.diagonal().y, bounds_.diagonal().z)
+                        : bounds_.diagonal();
+  start_origin_ = bounds_.lo;
+  const size_t cells = std::min(kStartCells, settings_.max_bytes / 8 / sizeof(uint32_t));
+  while (size_t(start_dims_[0]) * start_dims_[1] * start_dims_[2] * 2 <= cells) {
+    int a = 0;
+    for (int k = 1; k < 3; ++k)
+      if (d[k] / float(start_dims_[k]) > d[a] / float(start_dims_[a])) a = k;
+    if (!(d[a] > 0)) break;  // a box of one point
+    start_dims_[a] *= 2;
+  }
+  for (int k = 0; k < 3; ++k) start_scale_[k] = d[k] > 0 ? float(start_dims_[k]) / d[k] : 0.f;
+  build_start_grid();
   refresh_guides();
+}
+
+void GuidingField::build_start_grid() {
+  start_.resize(size_t(start_dims_[0]) * start_dims_[1] * start_dims_[2]);
+  int cell[3];
+  auto bound = [&](int axis, int i) {  // the lower plane of cell i along axis (inf outside)
+    if (i <= 0) return -kInfinity;
+    if (i >= start_dims_[axis]) return kInfinity;
+    return start_origin_[axis] + float(i) / start_scale_[axis];
+  };
+  size_t at = 0;
+  for (cell[2] = 0; cell[2] < start_dims_[2]; ++cell[2])
+    for (cell[1] = 0; cell[1] < start_dims_[1]; ++cell[1])
+      for (cell[0] = 0; cell[0] < start_dims_[0]; ++cell[0]) {
+        uint32_t node = 0;
+        while (nodes_[node].axis() != SpatialNode::kLeaf) {
+          const int a = int(nodes_[node].axis());
+          // Planes within a ten-thousandth of a cell of its border (the cells' and the planes'
+          // float rounding) count as on it; start_node() sends points that close to a border to
+          // the root instead.
+          const float tolerance = kStartTolerance / 10 / start_scale_[a];
+          const float m = nodes_[node].middle;
+          if (m <= bound(a, cell[a]) + tolerance) {
+            node = nodes_[node].index() + 1;  // the whole cell is above the plane
+          } else if (m >= bound(a, cell[a] + 1) - tolerance) {
+            node = nodes_[node].index();
+          } else {
+            break;  // the plane crosses the cell: points decide from here
+          }
+        }
+        start_[at++] = node;
+      }
+}
+
+uint32_t GuidingField::start_node(Vec3 p) const {
+  size_t index = 0;
+  for (int a = 2; a >= 0; --a) {
+    const float t = (p[a] - start_origin_[a]) * start_scale_[a];
+    const int last = start_dims_[a] - 1;
+    if (!(t < float(last))) {  // the last cell, which reaches to infinity (NaN: the root)
+      if (!(t >= float(last) + kStartTolerance)) return 0;
+      index = index * size_t(start_dims_[a]) + size_t(last);
+      continue;
+    }
+    const int i = t > 0 ? int(t) : 0;  // the first cell reaches to minus infinity
+    const float f = t - float(i);
+    // Within a thousandth of a cell of an inner border: the cell's decisions may not hold.
+    if (f > 1 - kStartTolerance || (i > 0 && f < kStartTolerance)) return 0;
+    index = index * size_t(start_dims_[a]) + size_t(i);
+  }
+  return start_[index];
 }
 
 int GuidingField::side_class(Vec3 n) {
@@ -77,7 +134,8 @@ void GuidingField::add_vertex_counts(const std::vector<uint32_t>& counts) {
 }
 
 uint32_t GuidingField::leaf_at(Vec3 p, int side) const {
-  return leaf_of_point(class_point(p, side), sided_ ? class_root_[size_t(side)] : 0);
+  const Vec3 q = class_point(p, side);
+  return leaf_of_point(q, start_node(q));
 }
 
 uint32_t GuidingField::leaf_of_point(Vec3 p, uint32_t start) const {
@@ -262,6 +320,7 @@ void GuidingField::end_pass(int k) {
     l.recording = DirectionalQuadtree();
   }
   split_leaves(k);
+  build_start_grid();
   refresh_guides();  // leaves_ moved: the pointers change
   const size_t bytes = memory_bytes();
   size_t budget = settings_.max_bytes > bytes
@@ -284,7 +343,8 @@ size_t GuidingField::quadtree_node_count() const {
 
 size_t GuidingField::memory_bytes() const {
   size_t bytes = nodes_.capacity() * sizeof(SpatialNode) + leaves_.capacity() * sizeof(Leaf) +
-                 counts_.capacity() * sizeof(uint64_t) + guides_.capacity() * sizeof(Guide);
+                 counts_.capacity() * sizeof(uint64_t) + guides_.capacity() * sizeof(Guide) +
+                 start_.capacity() * sizeof(uint32_t);
   for (const Leaf& l : leaves_) bytes += l.sampling.bytes() + l.recording.bytes();
   return bytes;
 }

@@ -77,6 +77,8 @@ class GuidingField {
   uint32_t jittered_leaf(Vec3 p, uint32_t leaf, Vec3 u, int side = 0) const;
   // The distribution learned for the leaf; its total() is 0 until some radiance was recorded.
   const DirectionalQuadtree& sampling(uint32_t leaf) const { return leaves_[leaf].sampling; }
+  // The leaf's box (in the copy of its side class where the field is sided).
+  const Bounds3& leaf_box(uint32_t leaf) const { return leaves_[leaf].box; }
   // The probability of sampling the BSDF at the leaf (fixed, or learned: guiding_settings.h).
   float bsdf_fraction(uint32_t leaf) const;
   // What a vertex in the leaf samples with, in one small record read per vertex: the learned
@@ -130,6 +132,16 @@ class GuidingField {
   void split(uint32_t node, std::vector<uint64_t>& counts, int axis = -1);
   // The leaf holding p, descending from node `start` (p must lie in its box).
   uint32_t leaf_of_point(Vec3 p, uint32_t start) const;
+  // The start grid: a uniform grid over the root box (dyadic cells, about cubic, at most
+  // kStartCells and an eighth of the memory cap) holding per cell the deepest node whose box
+  // contains the whole cell, the outer cells reaching to infinity. A descent starts at its
+  // point's cell: the same leaf as from the root, a dozen fewer dependent loads. Points within
+  // kStartTolerance of a cell's inner border (where float rounding could put them in the wrong
+  // cell) start at the root. Rebuilt whenever the tree changes.
+  static constexpr size_t kStartCells = size_t(1) << 13;
+  static constexpr float kStartTolerance = 1e-3f;  // in cells
+  void build_start_grid();
+  uint32_t start_node(Vec3 p) const;
   // p clamped into the scene's box along x and moved into the copy of its side class.
   Vec3 class_point(Vec3 p, int side) const;
   void split_leaves(int k);
@@ -139,8 +151,10 @@ class GuidingField {
   Bounds3 bounds_;        // the scene's box (copy 0)
   float copy_width_ = 0;  // sided: the x extent of one copy
   bool sided_ = false;
-  std::array<uint32_t, 8> class_root_{};  // sided: the node of each copy (the top 3 levels)
-  std::vector<SpatialNode> nodes_;        // nodes_[0] is the root
+  std::vector<SpatialNode> nodes_;  // nodes_[0] is the root
+  std::vector<uint32_t> start_;     // the start grid, x fastest
+  std::array<int, 3> start_dims_{1, 1, 1};
+  Vec3 start_origin_, start_scale_;  // cell coordinates of p: (p - origin) * scale
   std::vector<Leaf> leaves_;
   std::vector<uint64_t> counts_;        // path vertices per leaf in the current pass
   std::vector<Guide> guides_;           // per leaf

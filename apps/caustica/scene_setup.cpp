@@ -15,10 +15,10 @@ namespace {
 void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
   o.number("--guiding-spatial-threshold", &s->guiding.spatial_threshold, 0, 1e12, true,
            "Guiding: split a spatial leaf after c sqrt(2^k) path vertices in training pass k "
-           "(default c = 4000 for guided-pt, 12000 for guided-bpt/vcm as Mueller 2017)");
+           "(default 4000; Mueller 2017: 12000)");
   o.number("--guiding-rho", &s->guiding.rho, 0, 1, true,
            "Guiding: refine a directional quadrant holding more than this share of the energy "
-           "(default 0.05 for guided-pt, 0.01 for guided-bpt/vcm as Mueller 2017)");
+           "(default 0.05; Mueller 2017: 0.01)");
   o.integer("--guiding-max-mb", &s->guiding_max_mb, 1, 65536,
             "Guiding: memory cap of the learned structure in MiB (default 32)");
   o.number("--guiding-bsdf-fraction", &s->guiding.bsdf_fraction, 0, 1, true,

@@ -295,8 +295,7 @@ size_t GuidingField::leaf_bytes(const Leaf& l) const {
 }
 
 void GuidingField::split_leaves(int k) {
-  const double threshold =
-      settings_.threshold_or(GuidingSettings::kMuellerThreshold) * std::sqrt(std::ldexp(1.0, k));
+  const double threshold = settings_.spatial_threshold * std::sqrt(std::ldexp(1.0, k));
   size_t bytes = memory_bytes();
   std::vector<uint64_t>& counts = counts_;
   // nodes_ grows inside the loop: new children are visited too, so a leaf splits repeatedly.
@@ -327,8 +326,7 @@ void GuidingField::end_pass(int k) {
                       ? (settings_.max_bytes - bytes) / DirectionalQuadtree::kNodeBytes
                       : 0;
   for (Leaf& l : leaves_) {
-    l.recording = l.sampling.refined(settings_.rho_or(GuidingSettings::kMuellerRho),
-                                     settings_.max_quadtree_depth, &budget);
+    l.recording = l.sampling.refined(settings_.rho, settings_.max_quadtree_depth, &budget);
     l.recording.shrink_to_fit();
   }
   counts_.assign(leaves_.size(), 0);

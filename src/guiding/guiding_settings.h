@@ -10,24 +10,17 @@ namespace caustica {
 
 struct GuidingSettings {
   // c of the spatial split rule: a leaf that recorded more than c sqrt(2^k) path vertices in
-  // training pass k (2^k samples per pixel) is split (Müller et al. 2017, sec. 3.4). 0: the
-  // integrator's default (threshold_or_default): Müller's 12000, except guided-pt's 4000, which
-  // was 1.07x better at equal time on door-ajar (320x240, 60 s, three seeds: relMSE
-  // 0.310-0.326 against 0.334-0.345) while guided-vcm was worse with it (0.432 against 0.395).
-  double spatial_threshold = 0;
-  static constexpr double kMuellerThreshold = 12000, kGuidedPtThreshold = 4000;
-  double threshold_or(double fallback) const {
-    return spatial_threshold > 0 ? spatial_threshold : fallback;
-  }
-  // A directional quadrant is refined where its share of the leaf's energy exceeds rho. 0: the
-  // integrator's default (rho_or): Müller's 0.01, except guided-pt's 0.05. guided-pt splits its
-  // spatial leaves at a third of Müller's count, so a leaf's quadtree learns from fewer records
-  // and its shares are noisier: at 0.01 one bright record carves a narrow peak that the next
-  // pass samples. On door-ajar (320x240, 20 s, 2 threads, seeds 1 and 2) relMSE 0.74 and 0.85
-  // at 0.05 against 0.99 and 1.01 at 0.01 (0.03: 0.77; 0.06: 0.72 and 0.74; 0.12: 0.85).
-  double rho = 0;
-  static constexpr double kMuellerRho = 0.01, kGuidedPtRho = 0.05;
-  double rho_or(double fallback) const { return rho > 0 ? rho : fallback; }
+  // training pass k (2^k samples per pixel) is split (Müller et al. 2017, sec. 3.4). Müller's
+  // 12000 would leave more records per leaf; 4000 was 1.07x better for guided-pt at equal time on
+  // door-ajar (320x240, 60 s, three seeds: relMSE 0.310-0.326 against 0.334-0.345, at rho 0.01).
+  double spatial_threshold = 4000;
+  // A directional quadrant is refined where its share of the leaf's energy exceeds rho (Müller:
+  // 0.01). With a third of Müller's records per leaf the shares are noisier: at 0.01 one bright
+  // record carves a narrow peak that the next pass samples. guided-pt on door-ajar (320x240,
+  // 20 s, 2 threads, seeds 1 and 2): relMSE 0.74 and 0.85 at 0.05 against 0.99 and 1.01 at 0.01
+  // (seed 1 at 0.03: 0.77; 0.06: 0.72; 0.12: 0.85). guided-vcm at 64 spp (seed 1): 0.663 with
+  // (4000, 0.05) against 0.764 with Müller's (12000, 0.01); vcm 0.797.
+  double rho = 0.05;
   int max_quadtree_depth = 20;
   // The memory cap: the whole structure (spatial tree, leaves, directional quadtrees) stays
   // under this many bytes; splits and refinements that would exceed it are not done.

@@ -206,10 +206,7 @@ class PathLearning {
 
 void GuidedPathTracer::prepare(const Scene& scene, Film& film) {
   CameraPathIntegrator::prepare(scene, film);
-  GuidingSettings guiding = settings_.guiding;
-  guiding.spatial_threshold = guiding.threshold_or(GuidingSettings::kGuidedPtThreshold);
-  guiding.rho = guiding.rho_or(GuidingSettings::kGuidedPtRho);
-  field_ = GuidingField(scene.bounds(), guiding, /*sided=*/true);
+  field_ = GuidingField(scene.bounds(), settings_.guiding, /*sided=*/true);
   passes_ = InverseVarianceCombiner(scene.camera().width(), scene.camera().height());
   schedule_ = TrainingSchedule(budget_spp(), budget_seconds());
   start_ = std::chrono::steady_clock::now();

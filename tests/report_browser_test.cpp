@@ -4,6 +4,7 @@
 // must not be blank.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -33,6 +34,23 @@ std::string chromium_command(const fs::path& profile) {
 
 bool chromium_available() { return std::system("command -v chromium >/dev/null 2>&1") == 0; }
 
+// Runs `caustica compare cornell` with the integrators into dir/report and returns the DOM of its
+// index.html after the page's #selftest ran in headless Chromium.
+std::string compare_and_selftest(const fs::path& dir, const std::string& integrators) {
+  const std::string compare =
+      std::string(CAUSTICA_BINARY) + " compare cornell --integrators " + integrators +
+      " --time 1 --reference-time 1 --resolution 48x48 --reference-integrator pt --out " +
+      (dir / "report").string() + " > " + (dir / "compare.log").string() + " 2>&1";
+  EXPECT_EQ(std::system(compare.c_str()), 0) << read_file(dir / "compare.log");
+  const std::string url = "file://" + (dir / "report" / "index.html").string();
+  const std::string dump =
+      chromium_command(dir / "profile") +
+      " --enable-logging=stderr --v=0 --virtual-time-budget=10000 --dump-dom '" + url +
+      "#selftest' > " + (dir / "dom.html").string() + " 2> " + (dir / "chromium.log").string();
+  EXPECT_EQ(std::system(dump.c_str()), 0) << read_file(dir / "chromium.log");
+  return read_file(dir / "dom.html");
+}
+
 }  // namespace
 
 TEST(ReportBrowser, ViewerPlotAndTableWorkInHeadlessChromium) {
@@ -47,11 +65,7 @@ TEST(ReportBrowser, ViewerPlotAndTableWorkInHeadlessChromium) {
   std::string integrators = "pt";
   for (const auto& n : caustica::integrator_names())
     if (n == "bpt" || (n == "lt" && integrators == "pt")) integrators = "pt," + n;
-  const std::string compare =
-      std::string(CAUSTICA_BINARY) + " compare cornell --integrators " + integrators +
-      " --time 1 --reference-time 1 --resolution 48x48 --reference-integrator pt --out " +
-      (dir / "report").string() + " > " + (dir / "compare.log").string() + " 2>&1";
-  ASSERT_EQ(std::system(compare.c_str()), 0) << read_file(dir / "compare.log");
+  const std::string dom = compare_and_selftest(dir, integrators);
   for (const char* f : {"index.html", "results.json", "results.csv", "convergence.svg",
                         "reference.png", "pt.png", "pt.exr", "pt_error.png"})
     EXPECT_TRUE(fs::exists(dir / "report" / f)) << f;
@@ -60,12 +74,6 @@ TEST(ReportBrowser, ViewerPlotAndTableWorkInHeadlessChromium) {
   EXPECT_EQ(html.find("https://"), std::string::npos);
 
   const std::string url = "file://" + (dir / "report" / "index.html").string();
-  const std::string dump =
-      chromium_command(dir / "profile") +
-      " --enable-logging=stderr --v=0 --virtual-time-budget=10000 --dump-dom '" + url +
-      "#selftest' > " + (dir / "dom.html").string() + " 2> " + (dir / "chromium.log").string();
-  ASSERT_EQ(std::system(dump.c_str()), 0) << read_file(dir / "chromium.log");
-  const std::string dom = read_file(dir / "dom.html");
   EXPECT_NE(dom.find("<title>selftest:pass</title>"), std::string::npos)
       << dom.substr(0, std::min<size_t>(dom.size(), 400));
   // Any console message from the page (errors, uncaught exceptions) is a failure.
@@ -88,4 +96,25 @@ TEST(ReportBrowser, ViewerPlotAndTableWorkInHeadlessChromium) {
   const double mean = sum / img.pixel_count();
   const double stddev = std::sqrt(std::max(0.0, sum2 / img.pixel_count() - mean * mean));
   EXPECT_GT(stddev, 0.05) << "the screenshot is blank (mean " << mean << ")";
+}
+
+// A click on the picture shows what guided-pt learned at that pixel: the page's #selftest clicks
+// the middle of the picture and checks the caption names that pixel and the view was drawn.
+TEST(ReportBrowser, AClickShowsWhatGuidingLearnedAtThatPixel) {
+  if (!chromium_available()) {
+    if (std::getenv("CI")) FAIL() << "chromium is not installed (scripts/test.sh installs it)";
+    GTEST_SKIP() << "chromium is not installed; run scripts/install-deps.sh chromium";
+  }
+  const auto names = caustica::integrator_names();
+  if (std::find(names.begin(), names.end(), "guided-pt") == names.end()) GTEST_SKIP();
+  const fs::path dir = fs::path(testing::TempDir()) / "caustica_report_click_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string dom = compare_and_selftest(dir, "pt,guided-pt");
+  EXPECT_NE(dom.find("<title>selftest:pass</title>"), std::string::npos);
+  const size_t at = dom.find("<div id=\"guideselftest\" class=\"hint\">");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_EQ(dom.substr(at, 80).find("guideselftest:pass"), 37u) << dom.substr(at, 200);
+  const std::string log = read_file(dir / "chromium.log");
+  EXPECT_EQ(log.find("CONSOLE"), std::string::npos) << log;
 }

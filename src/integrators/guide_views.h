@@ -4,7 +4,10 @@
 // of the side the camera sees (GuidingField::side_class), as a kViewWidth x kViewHeight grid of
 // its solid-angle density over the world's (phi, cos theta) square (guiding/
 // directional_quadtree.h: x = phi / 2 pi, y = (cos theta + 1) / 2, z up), and the spatial leaf's
-// box. The compare report draws them (experiment/guide_view.h).
+// box. The compare report draws them (experiment/guide_view.h). For the report's click (the
+// view at a clicked pixel) also a grid of kClickColumns columns (and rows for square cells) of
+// such views, each as its grey levels (255 sqrt(density / its largest), base64; "" where the
+// ray misses or nothing was learned), row-major: {"grid": {"columns", "rows", "cells"}}.
 #pragma once
 
 #include <functional>
@@ -17,12 +20,13 @@ namespace caustica {
 
 class Scene;
 
-inline constexpr int kViewWidth = 32, kViewHeight = 16;
+inline constexpr int kViewWidth = 32, kViewHeight = 16, kClickColumns = 16;
 
 // lookup(p, side): the distribution learned at p for side class `side` (nullptr: none).
-// Returns {"width", "height", "views": [{"pixel": [x, y], "point": [..], "density": [...]}]},
-// a view without "density" where nothing was learned or the ray missed.
-nlohmann::json guide_views(
-    const Scene& scene, const std::function<const DirectionalQuadtree*(Vec3 p, int side)>& lookup);
+using GuideLookup = std::function<const DirectionalQuadtree*(Vec3 p, int side)>;
+
+// Returns {"width", "height", "views": [{"pixel": [x, y], "point": [..], "density": [...]}],
+// "grid": ...}, a view without "density" where nothing was learned or the ray missed.
+nlohmann::json guide_views(const Scene& scene, const GuideLookup& lookup);
 
 }  // namespace caustica

@@ -1,5 +1,7 @@
 #include "integrators/bidir/adaptive_plan.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <bit>
 #include <cassert>
@@ -39,6 +41,7 @@ constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
 constexpr int kBlurRadius = 3;        // pixel variances pooled over 7 x 7 (box_blur)
 constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
 constexpr int kFirstProbes = 2;
+constexpr size_t kPixelBlock = 4096;  // the choice's parallel blocks (for_pixel_blocks)
 // Path tracing is kept unless another configuration's predicted relVar x time is lower by more
 // than this factor. The cost model has no term for the per-iteration costs of light paths (their
 // pipeline, the splats), and the predicted variances carry a few percent of noise: on mis-plates
@@ -86,9 +89,18 @@ std::vector<double> box_blur(const std::vector<double>& in, int w, int h, int r)
       dst[size_t(i) * stride] = sum / count;
     }
   };
-  for (int y = 0; y < h; ++y) pass(&in[size_t(y) * w], &tmp[size_t(y) * w], w, 1);
-  for (int x = 0; x < w; ++x) pass(&tmp[x], &out[x], h, w);
+  // Rows, then columns, each independent of the others: in parallel, the same sums.
+  tbb::parallel_for(0, h, [&](int y) { pass(&in[size_t(y) * w], &tmp[size_t(y) * w], w, 1); });
+  tbb::parallel_for(0, w, [&](int x) { pass(&tmp[x], &out[x], h, w); });
   return out;
+}
+
+// fn(begin, end) over [0, n) in blocks of a fixed size, in parallel: per-block partial sums
+// added in block order afterwards are the same for any thread count.
+template <typename Fn>
+void for_pixel_blocks(size_t n, Fn&& fn) {
+  tbb::parallel_for(size_t(0), (n + kPixelBlock - 1) / kPixelBlock,
+                    [&](size_t b) { fn(b, b * kPixelBlock, std::min(n, (b + 1) * kPixelBlock)); });
 }
 
 // Per pixel and iteration, from the probes' work (light paths at one per pixel).
@@ -258,12 +270,14 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
   // differences everywhere else and lets the cheapest candidate win. What a candidate has beyond
   // the least (its own fireflies: missing connections, fewer light paths) is kept in full.
   std::vector<double> shared(pixels_);
-  for (size_t p = 0; p < pixels_; ++p) {
-    double least = std::numeric_limits<double>::infinity();
-    for (size_t j = 0; j < kCandidates; ++j)
-      least = std::min(least, relative_variance(p, j, means));
-    shared[p] = least;
-  }
+  for_pixel_blocks(pixels_, [&](size_t, size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p) {
+      double least = std::numeric_limits<double>::infinity();
+      for (size_t j = 0; j < kCandidates; ++j)
+        least = std::min(least, relative_variance(p, j, means));
+      shared[p] = least;
+    }
+  });
   std::vector<double> sorted = shared;
   const size_t q = std::min(pixels_ - 1, size_t(double(pixels_) * kWinsorize));
   std::nth_element(sorted.begin(), sorted.begin() + q, sorted.end());
@@ -275,7 +289,9 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
 std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector<float>& means,
                                                      const std::vector<double>& correction) const {
   std::vector<double> v(pixels_);
-  for (size_t p = 0; p < pixels_; ++p) v[p] = relative_variance(p, j, means) + correction[p];
+  for_pixel_blocks(pixels_, [&](size_t, size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p) v[p] = relative_variance(p, j, means) + correction[p];
+  });
   return box_blur(v, width_, height_, kBlurRadius);
 }
 
@@ -302,14 +318,26 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     const double extra = j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t);
     const std::vector<double> no_merge = j == 0 ? pt : relative_variances(j, means, correction);
     const std::vector<double> merge = j == 0 ? pt : relative_variances(j + 1, means, correction);
+    // Per block of pixels: variance, cost, variance without and with merging everywhere.
+    std::vector<std::array<double, 4>> blocks((pixels_ + kPixelBlock - 1) / kPixelBlock);
+    for_pixel_blocks(pixels_, [&](size_t b, size_t begin, size_t end) {
+      std::array<double, 4> sum{};
+      for (size_t p = begin; p < end; ++p) {
+        const double v0 = no_merge[p], v1 = merge[p];
+        sum[2] += v0;
+        sum[3] += v1;
+        mask[p] = j != 0 && v1 * (cost + extra) < v0 * cost;
+        sum[0] += mask[p] ? v1 : v0;
+        sum[1] += mask[p] ? cost + extra : cost;
+      }
+      blocks[b] = sum;
+    });
     double variance = 0, total_cost = 0, variance0 = 0, variance1 = 0;
-    for (size_t p = 0; p < pixels_; ++p) {
-      const double v0 = no_merge[p], v1 = merge[p];
-      variance0 += v0;
-      variance1 += v1;
-      mask[p] = j != 0 && v1 * (cost + extra) < v0 * cost;
-      variance += mask[p] ? v1 : v0;
-      total_cost += mask[p] ? cost + extra : cost;
+    for (const std::array<double, 4>& sum : blocks) {
+      variance += sum[0];
+      total_cost += sum[1];
+      variance0 += sum[2];
+      variance1 += sum[3];
     }
     const double score = variance * total_cost;
     table.push_back({{"light_path_factor", c.light_path_factor},

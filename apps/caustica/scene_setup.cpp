@@ -28,9 +28,9 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
            "Guiding: box-filtered splatting into the spatial and directional trees, on or off "
            "(default on)");
   o.choice("--guiding-target", &s->guiding_target, {"cosine", "radiance"},
-           "Guiding: what the directional distributions learn, incident radiance times the "
-           "cosine to the surface (a product with the cosine) or radiance alone as Mueller 2017 "
-           "(default cosine)");
+           "Guiding (guided-pt): what the directional distributions learn, incident radiance "
+           "times the cosine to the surface (a product with the cosine) or radiance alone as "
+           "Mueller 2017 (default cosine)");
   o.choice("--guiding-combine", &s->guiding_combine, {"inverse-variance", "equal"},
            "Guiding: weight the training passes in the image by inverse variance, or every "
            "iteration equally (default inverse-variance)");

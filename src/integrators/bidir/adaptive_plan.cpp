@@ -95,7 +95,7 @@ std::vector<double> box_blur(const std::vector<double>& in, int w, int h, int r)
   return out;
 }
 
-// fn(begin, end) over [0, n) in blocks of a fixed size, in parallel: per-block partial sums
+// fn(block, begin, end) over [0, n) in blocks of a fixed size, in parallel: per-block partial sums
 // added in block order afterwards are the same for any thread count.
 template <typename Fn>
 void for_pixel_blocks(size_t n, Fn&& fn) {

@@ -105,9 +105,13 @@ std::string click_html(const ComparisonResult& result) {
   std::ostringstream canvases;
   for (const auto& run : result.runs) {
     if (!run.integrator_stats.contains("guiding")) continue;
-    const auto& views = run.integrator_stats["guiding"].value("views", nlohmann::json());
+    const nlohmann::json& guiding = run.integrator_stats["guiding"];
+    if (!guiding.contains("views")) continue;
+    const nlohmann::json& views = guiding["views"];
     for (const char* name : {"", "radiance", "importance"}) {
-      const nlohmann::json& v = *name ? views.value(name, nlohmann::json()) : views;
+      // guided-pt's views are the field's; guided-bpt/vcm hold one per field.
+      if (*name && !views.contains(name)) continue;
+      const nlohmann::json& v = *name ? views[name] : views;
       if (!v.is_object() || !v.contains("grid")) continue;
       const int k = int(fields.size());
       fields.push_back({{"width", v["width"]},

@@ -23,9 +23,9 @@
 // to the BSDF where the guide does not help). With a time budget, guiding must also pay for its
 // time, which trials decide: one pass guided and one unguided of equal length, and the one
 // with the lower variance x seconds (the inverse of efficiency) wins. The first trial (8
-// iterations each) follows training pass 3: if guiding loses by more than 10% (its field will
-// only get better), rendering starts unguided at once (an easy scene stops paying for
-// training early); else training goes on and the render stays guided. Without that trial (training
+// iterations each) follows training pass 3: if guiding loses (training would cost more time on
+// top), rendering starts unguided at once (an easy scene stops paying for training early);
+// else training goes on and the render stays guided. Without that trial (training
 // stopped earlier), one follows training (half the last training pass each, at least 8). A
 // two-sample unguided pass 0 cannot decide this: its variance estimate misses the rare, bright
 // paths that dominate scenes such as door-ajar (2 spp measured 32 per sample there, 43 over the

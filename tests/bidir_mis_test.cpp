@@ -269,7 +269,7 @@ std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene) {
   GuidingSettings settings;
   settings.spatial_threshold = 200;
   settings.bsdf_fraction = 0.3f;
-  g->prepare(scene.bounds(), settings, 1024, 0, 0);  // no budget: it trains forever
+  g->prepare(scene.bounds(), settings, 6000, 0, 0);  // no budget: it trains forever; 6000 pixels
   const InverseVarianceCombiner no_variances;
   std::mt19937 gen(5);
   std::uniform_real_distribution<float> u(0.f, 1.f);

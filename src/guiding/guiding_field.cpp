@@ -1,13 +1,14 @@
 #include "guiding/guiding_field.h"
 
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <memory>
 #include <utility>
 
 namespace caustica {
@@ -205,63 +206,69 @@ void GuidingField::record_into(Leaf& leaf, const GuidingRecord& r) {
     leaf.selection.add(r.product, r.bsdf_pdf, r.guide_pdf, r.statistical_weight);
 }
 
-void GuidingField::splat(std::vector<GuidingRecord>& records) {
-  // (leaf, key) is unique for the caller's keys, so any sort gives the same order. Sorted as
-  // one 64-bit number (a radix sort over just the bits in use) when leaf and key fit.
-  uint64_t largest_key = 0;
-  for (const GuidingRecord& r : records) largest_key = std::max(largest_key, r.key);
-  const int key_bits = std::bit_width(largest_key);
-  const int bits = key_bits + std::bit_width(uint64_t(leaves_.size()));
-  if (bits <= 64) {
-    for (GuidingRecord& r : records) r.key |= uint64_t(r.leaf) << key_bits;
-    radix_sort_by_key(records, bits);
-  } else {
-    tbb::parallel_sort(records.begin(), records.end(),
-                       [](const GuidingRecord& a, const GuidingRecord& b) {
-                         return a.leaf != b.leaf ? a.leaf < b.leaf : a.key < b.key;
-                       });
+GuidingRecord* GuidingField::RecordScratch::reserve(size_t n) {
+  if (n > capacity_) {
+    data_.reset(static_cast<GuidingRecord*>(::operator new(n * sizeof(GuidingRecord))));
+    capacity_ = n;
   }
-  std::vector<size_t> starts;
-  for (size_t i = 0; i < records.size(); ++i)
-    if (i == 0 || records[i].leaf != records[i - 1].leaf) starts.push_back(i);
-  starts.push_back(records.size());
-  tbb::parallel_for(size_t(0), starts.size() - 1, [&](size_t g) {
-    Leaf& leaf = leaves_[records[starts[g]].leaf];
-    for (size_t i = starts[g]; i < starts[g + 1]; ++i) record_into(leaf, records[i]);
-  });
-  refresh_guides();
+  return data_.get();
 }
 
-// LSD radix sort by key (stable; keys below 2^bits), 11-bit digits. Each pass counts and
-// scatters a fixed number of chunks in parallel (chunk c of bucket b goes after every earlier
-// chunk of b), so the result is the same for any thread count.
-void GuidingField::radix_sort_by_key(std::vector<GuidingRecord>& records, int bits) {
-  constexpr int kDigit = 11;
-  constexpr size_t kBuckets = size_t(1) << kDigit, kChunks = 16;
-  scratch_.resize(records.size());
-  const size_t chunk = (records.size() + kChunks - 1) / kChunks;
-  std::vector<size_t> offsets(kChunks * kBuckets);
-  for (int shift = 0; shift < bits; shift += kDigit) {
-    auto digit = [shift](const GuidingRecord& r) { return (r.key >> shift) & (kBuckets - 1); };
-    auto for_chunks = [&](auto&& fn) {
-      tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
-        const size_t begin = std::min(records.size(), c * chunk);
-        fn(c, begin, std::min(records.size(), begin + chunk));
-      });
-    };
-    std::fill(offsets.begin(), offsets.end(), 0);
-    for_chunks([&](size_t c, size_t begin, size_t end) {
-      for (size_t i = begin; i < end; ++i) ++offsets[c * kBuckets + digit(records[i])];
+void GuidingField::splat(std::span<const std::span<const GuidingRecord>> runs) {
+  // kChunks chunks of about equal record counts, fixed by the runs alone (not by threads).
+  std::vector<size_t> first(runs.size() + 1, 0);
+  for (size_t i = 0; i < runs.size(); ++i) first[i + 1] = first[i] + runs[i].size();
+  const size_t n = first.back(), leaves = leaves_.size();
+  constexpr size_t kChunks = 16;
+  auto for_chunk = [&](size_t c, auto&& fn) {
+    const size_t begin = n * c / kChunks, end = n * (c + 1) / kChunks;
+    if (begin == end) return;
+    // The run holding record `begin`: the last whose first record is at or before it.
+    size_t run = size_t(std::upper_bound(first.begin(), first.end(), begin) - first.begin()) - 1;
+    for (size_t i = begin; i < end; ++run) {
+      const size_t stop = std::min(end, first[run + 1]);
+      for (const GuidingRecord& r : runs[run].subspan(i - first[run], stop - i)) fn(r);
+      i = stop;
+    }
+  };
+  // A stable counting sort by leaf: per chunk and leaf a count, then leaf-major offsets (leaf
+  // l's records of chunk c after those of the chunks before c), then the scatter.
+  std::vector<size_t> offsets(kChunks * leaves, 0);
+  std::array<uint64_t, kChunks> largest_key{};
+  tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
+    size_t* count = &offsets[c * leaves];
+    uint64_t largest = 0;
+    for_chunk(c, [&](const GuidingRecord& r) {
+      ++count[r.leaf];
+      largest = std::max(largest, r.key);
     });
-    size_t sum = 0;
-    for (size_t b = 0; b < kBuckets; ++b)
-      for (size_t c = 0; c < kChunks; ++c) sum += std::exchange(offsets[c * kBuckets + b], sum);
-    for_chunks([&](size_t c, size_t begin, size_t end) {
-      for (size_t i = begin; i < end; ++i)
-        scratch_[offsets[c * kBuckets + digit(records[i])]++] = records[i];
-    });
-    records.swap(scratch_);
+    largest_key[c] = largest;
+  });
+  std::vector<uint32_t> used;  // leaves with records
+  std::vector<size_t> leaf_start(leaves + 1, 0);
+  size_t sum = 0;
+  for (size_t l = 0; l < leaves; ++l) {
+    leaf_start[l] = sum;
+    for (size_t c = 0; c < kChunks; ++c) sum += std::exchange(offsets[c * leaves + l], sum);
+    if (sum > leaf_start[l]) used.push_back(uint32_t(l));
   }
+  leaf_start[leaves] = sum;
+  // The directional filter's jitter hashes the key with the leaf (when both fit in 64 bits).
+  const int key_bits = std::bit_width(*std::max_element(largest_key.begin(), largest_key.end()));
+  const bool tag_leaf = key_bits + std::bit_width(uint64_t(leaves)) <= 64;
+  GuidingRecord* grouped = grouped_.reserve(n);
+  tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
+    size_t* at = &offsets[c * leaves];
+    for_chunk(c, [&](const GuidingRecord& r) {
+      GuidingRecord* g = std::construct_at(grouped + at[r.leaf]++, r);
+      if (tag_leaf) g->key |= uint64_t(r.leaf) << key_bits;
+    });
+  });
+  tbb::parallel_for(size_t(0), used.size(), [&](size_t u) {
+    const uint32_t l = used[u];
+    for (size_t i = leaf_start[l]; i < leaf_start[l + 1]; ++i) record_into(leaves_[l], grouped[i]);
+  });
+  refresh_guides();
 }
 
 // Müller et al. 2017, sec. 3.4: "we subdivide a leaf node if it contains more than

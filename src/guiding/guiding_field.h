@@ -18,14 +18,17 @@
 // stays under GuidingSettings::max_bytes. Splits and refinements that would exceed it are not
 // done (leaves are visited in index order, so what is kept is deterministic).
 //
-// Determinism: splat() sorts the records by (leaf, key), where the caller's key orders them
-// independently of threads (pixel and position along the path), and then processes the leaves in
-// parallel, each leaf's records in that order: the field does not depend on thread scheduling.
+// Determinism: splat() takes the records in an order that does not depend on threads (the caller's:
+// pixel, then position along the path; pixel_records.h gathers them so without a merged copy),
+// groups them by leaf keeping that order (a stable counting sort), and processes the leaves in
+// parallel, each leaf's records in order: the field does not depend on thread scheduling.
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <span>
 #include <vector>
 
 #include "core/vec.h"
@@ -97,8 +100,11 @@ class GuidingField {
   // Records one sample directly (sequential; tests), counting it as a vertex when its
   // statistical weight is positive.
   void record(const GuidingRecord& r);
-  // Sorts `records` and splats them (see Determinism above).
-  void splat(std::vector<GuidingRecord>& records);
+  // Splats the records of `runs`, run after run (see Determinism above).
+  void splat(std::span<const std::span<const GuidingRecord>> runs);
+  void splat(std::span<const GuidingRecord> records) { splat({&records, 1}); }
+  // The bytes of splat()'s buffer (kept between calls; not part of memory_bytes()).
+  size_t splat_buffer_bytes() const { return grouped_.bytes(); }
   // Ends training pass k (0-based, the k-th with 2^k samples per pixel); see above.
   void end_pass(int k);
 
@@ -127,7 +133,6 @@ class GuidingField {
     SelectionOptimizer selection;
   };
   void record_into(Leaf& leaf, const GuidingRecord& r);
-  void radix_sort_by_key(std::vector<GuidingRecord>& records, int bits);
   // Splits a leaf node in two at the middle of `axis` (-1: its box's longest axis).
   void split(uint32_t node, std::vector<uint64_t>& counts, int axis = -1);
   // The leaf holding p, descending from node `start` (p must lie in its box).
@@ -156,9 +161,26 @@ class GuidingField {
   std::array<int, 3> start_dims_{1, 1, 1};
   Vec3 start_origin_, start_scale_;  // cell coordinates of p: (p - origin) * scale
   std::vector<Leaf> leaves_;
-  std::vector<uint64_t> counts_;        // path vertices per leaf in the current pass
-  std::vector<Guide> guides_;           // per leaf
-  std::vector<GuidingRecord> scratch_;  // the radix sort's other buffer
+  std::vector<uint64_t> counts_;  // path vertices per leaf in the current pass
+  std::vector<Guide> guides_;     // per leaf
+  // Uninitialised storage for splat()'s records grouped by leaf, grown and kept, so that the
+  // parallel scatter, not a serial constructor, first touches its pages. A copy starts empty.
+  class RecordScratch {
+   public:
+    RecordScratch() = default;
+    RecordScratch(const RecordScratch&) {}
+    RecordScratch& operator=(const RecordScratch&) { return *this; }
+    GuidingRecord* reserve(size_t n);
+    size_t bytes() const { return capacity_ * sizeof(GuidingRecord); }
+
+   private:
+    struct Free {
+      void operator()(GuidingRecord* p) const { ::operator delete(p); }
+    };
+    std::unique_ptr<GuidingRecord, Free> data_;
+    size_t capacity_ = 0;
+  };
+  RecordScratch grouped_;
   void refresh_guides();
 };
 

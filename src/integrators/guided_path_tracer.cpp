@@ -139,10 +139,12 @@ struct GuidedVertex {
 class PathLearning {
  public:
   // weight: the pixels this one stands for (1 in `weight` pixels records; see kMaxRecords).
-  PathLearning(ScratchArena& arena, int max_vertices, uint64_t pixel,
-               std::vector<GuidingRecord>& records, float weight)
+  PathLearning(ScratchArena& arena, int max_vertices, uint64_t pixel, PixelRecords::Writer records,
+               float weight)
       : vertices_(static_cast<GuidedVertex*>(arena.allocate(
             sizeof(GuidedVertex) * size_t(std::max(max_vertices, 1)), alignof(GuidedVertex)))),
+        next_events_(static_cast<GuidingRecord*>(arena.allocate(
+            sizeof(GuidingRecord) * size_t(std::max(max_vertices, 1)), alignof(GuidingRecord)))),
         records_(records),
         key_(pixel * kKeysPerPixel),
         weight_(weight) {}
@@ -171,17 +173,22 @@ class PathLearning {
     r.radiance = seen.Li.luminance() * scale * m.record_weight(seen.wi);
     r.product = (seen.f * seen.Li).luminance() * scale;
     r.statistical_weight = 0;
-    if (r.radiance > 0 && std::isfinite(r.radiance)) records_.push_back(r);
+    if (r.radiance > 0 && std::isfinite(r.radiance)) next_events_[next_event_count_++] = r;
   }
   // Müller et al. 2017, sec. 3.2: each vertex splats L_i / pdf (times |cos| where the guides
   // learn the product with the cosine), an estimate of the flux through the quadrant it lands in.
+  // The records go out in key order (the vertices' and the next event samples' interleaved).
   void finish() {
+    int e = 0;
     for (int j = 0; j < count_; ++j) {
       GuidedVertex& v = vertices_[j];
+      for (; e < next_event_count_ && next_events_[e].key < v.record.key; ++e)
+        records_.push(next_events_[e]);
       v.record.radiance = weight_ * v.incident.luminance() * v.per_pdf;
       v.record.product = weight_ * (v.weight * v.incident).luminance();
-      if (v.record.radiance > 0 && std::isfinite(v.record.radiance)) records_.push_back(v.record);
+      if (v.record.radiance > 0 && std::isfinite(v.record.radiance)) records_.push(v.record);
     }
+    for (; e < next_event_count_; ++e) records_.push(next_events_[e]);
   }
 
  private:
@@ -196,8 +203,9 @@ class PathLearning {
   }
 
   GuidedVertex* vertices_;
-  int count_ = 0;
-  std::vector<GuidingRecord>& records_;
+  GuidingRecord* next_events_;  // kept until finish(), to go out in key order
+  int count_ = 0, next_event_count_ = 0;
+  PixelRecords::Writer records_;
   uint64_t key_;
   float weight_;
 };
@@ -231,31 +239,23 @@ void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, 
     passes_.end_iteration();
     return;
   }
-  for (std::vector<GuidingRecord>& r : records_) r.clear();
+  // Slot pixel / stride: the recorded pixels are stride apart.
+  records_.begin_iteration(film.pixel_count() / record_stride_ + 1);
   trace_camera_paths(scene, iteration, film);
   passes_.end_iteration();
-  merged_.clear();
-  // Reserved to the exact total: appending would double the capacity at a size that depends on
-  // how the tiles fell to the threads, and the reported peak (and memory) with it.
-  size_t total = 0;
-  for (const std::vector<GuidingRecord>& r : records_) total += r.size();
-  merged_.reserve(total);
-  for (const std::vector<GuidingRecord>& r : records_)
-    merged_.insert(merged_.end(), r.begin(), r.end());
-  // The next iteration records one pixel in k, k from this one's records per pixel: the
-  // buffers stay near kMaxRecords at any resolution (deterministic: counts, not threads).
-  const uint64_t per_all_pixels = uint64_t(merged_.size()) * record_stride_;
-  record_stride_ = std::max<uint64_t>(1, (per_all_pixels + kMaxRecords - 1) / kMaxRecords);
-  size_t bytes = merged_.capacity() * sizeof(GuidingRecord);
-  for (const std::vector<GuidingRecord>& r : records_)
-    bytes += r.capacity() * sizeof(GuidingRecord);
-  peak_record_bytes_ = std::max(peak_record_bytes_, bytes);
+  const size_t recorded = records_.size();
   for (std::vector<uint32_t>& counts : vertex_counts_) {
     field_.add_vertex_counts(counts);
     std::fill(counts.begin(), counts.end(), 0);
   }
-  field_.splat(merged_);
-  recorded_ += merged_.size();
+  field_.splat(records_.runs());
+  recorded_ += recorded;
+  peak_record_bytes_ =
+      std::max(peak_record_bytes_, records_.capacity_bytes() + field_.splat_buffer_bytes());
+  // The next iteration records one pixel in k, k from this one's records per pixel: the
+  // buffers stay near kMaxRecords at any resolution (deterministic: counts, not threads).
+  const uint64_t per_all_pixels = uint64_t(recorded) * record_stride_;
+  record_stride_ = std::max<uint64_t>(1, (per_all_pixels + kMaxRecords - 1) / kMaxRecords);
 }
 
 void GuidedPathTracer::finish(const Scene& scene, Film& film) {
@@ -285,8 +285,8 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
   std::optional<PathLearning> learning;
   std::vector<uint32_t>* vertex_counts = nullptr;
   if (learn) {
-    learning.emplace(arena, settings_.max_depth, sample.pixel, records_.local(),
-                     float(record_stride_));
+    learning.emplace(arena, settings_.max_depth, sample.pixel,
+                     records_.writer(sample.pixel / record_stride_), float(record_stride_));
     vertex_counts = &vertex_counts_.local();
     if (vertex_counts->size() != field_.leaf_count()) vertex_counts->assign(field_.leaf_count(), 0);
   }

@@ -48,9 +48,9 @@
 // record standing for k (its values and vertex counts times k), so the buffers do not grow
 // with the resolution.
 //
-// Determinism: records carry the key (pixel, position along the path); the field sorts them
-// and splats each spatial leaf's records in that order after the iteration, so the field and
-// the image do not depend on thread scheduling.
+// Determinism: records carry the key (pixel, position along the path) and are gathered in key
+// order (pixel_records.h); the field splats each spatial leaf's records in that order after the
+// iteration, so the field and the image do not depend on thread scheduling.
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
@@ -60,6 +60,7 @@
 #include <vector>
 
 #include "guiding/guiding_field.h"
+#include "guiding/pixel_records.h"
 #include "guiding/training_schedule.h"
 #include "image/inverse_variance.h"
 #include "integrators/camera_path.h"
@@ -94,17 +95,16 @@ class GuidedPathTracer final : public CameraPathIntegrator {
   std::chrono::steady_clock::time_point start_;  // prepare(): time budgets
   uint64_t recorded_ = 0;
   size_t peak_record_bytes_ = 0;
-  // Records per training iteration are kept near this (40 MiB at 40 bytes; the merged copy and
-  // the sort double it): one pixel in record_stride_ records, its records weighted by the stride
-  // (pixel + iteration ≡ 0 mod stride, so every pixel takes its turn). The first iteration
+  // Records per training iteration are kept near this (40 MiB at 40 bytes; the field's copy
+  // grouped by leaf doubles it): one pixel in record_stride_ records, its records weighted by the
+  // stride (pixel + iteration ≡ 0 mod stride, so every pixel takes its turn). The first iteration
   // guesses kFirstRecordsPerPixel (mirror-caustic makes about 14 at 320x240, cornell-box 6).
   static constexpr size_t kMaxRecords = size_t(1) << 20;
   static constexpr size_t kFirstRecordsPerPixel = 8;
   uint64_t record_stride_ = 1;
-  mutable tbb::enumerable_thread_specific<std::vector<GuidingRecord>> records_;
+  PixelRecords records_;
   // Path vertices per spatial leaf, per thread (added to the field after each iteration).
   mutable tbb::enumerable_thread_specific<std::vector<uint32_t>> vertex_counts_;
-  std::vector<GuidingRecord> merged_;
   nlohmann::json views_;  // what was learned at a few pixels (guide_views.h), by finish()
   // Written by estimate(): one writer per pixel at a time.
   mutable InverseVarianceCombiner passes_;

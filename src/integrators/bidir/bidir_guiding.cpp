@@ -29,6 +29,7 @@ void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint
   iteration_ = 0;
   // About four camera vertices per path: one pixel in k keeps the records under kMaxRecords.
   camera_stride_ = std::max<uint64_t>(1, (4 * pixels + kMaxRecords - 1) / kMaxRecords);
+  pixels_ = pixels;
   radiance_records_ = importance_records_ = 0;
 }
 
@@ -47,7 +48,7 @@ bool BidirGuiding::begin_iteration(uint32_t iteration, double elapsed,
     }
     new_pass = true;
   }
-  for (std::vector<GuidingRecord>& r : camera_records_) r.clear();
+  if (schedule_.learning()) camera_records_.begin_iteration(pixels_ / camera_stride_ + 1);
   return new_pass;
 }
 
@@ -100,19 +101,20 @@ void BidirGuiding::record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 
                                         Rgb beta) const {
   const float value = beta.luminance();
   if (!(value > 0) || !std::isfinite(value)) return;
-  camera_records_.local().push_back(
-      record_at(importance_, pixel * kKeysPerPixel + uint64_t(depth), p, ng, wo, value));
+  camera_records_.writer(pixel / camera_stride_)
+      .push(record_at(importance_, pixel * kKeysPerPixel + uint64_t(depth), p, ng, wo,
+                      value * float(camera_stride_)));
 }
 
-void BidirGuiding::learn(GuidingField& field, std::vector<GuidingRecord>& records, float stride) {
-  // Every record stands for `stride` vertices: in the split rule's counts and in its value.
+void BidirGuiding::learn(GuidingField& field, std::span<const std::span<const GuidingRecord>> runs,
+                         uint64_t stride) {
+  // Every record stands for `stride` vertices in the split rule's counts (and its value was
+  // scaled by the stride when it was made).
   std::vector<uint32_t> counts(field.leaf_count(), 0);
-  for (GuidingRecord& r : records) {
-    counts[r.leaf] += uint32_t(stride);
-    r.radiance *= stride;
-  }
+  for (std::span<const GuidingRecord> run : runs)
+    for (const GuidingRecord& r : run) counts[r.leaf] += uint32_t(stride);
   field.add_vertex_counts(counts);
-  field.splat(records);
+  field.splat(runs);
 }
 
 void BidirGuiding::end_iteration(const Scene& scene,
@@ -128,19 +130,17 @@ void BidirGuiding::end_iteration(const Scene& scene,
     const size_t i = first + j * stride;
     const LightVertexData v = unpack_light_vertex(light_vertices[i]);
     const Vec3 ng = scene.interaction_at(v.primitive, v.p, v.wo).ng;
-    merged_[j] = record_at(radiance_, i, v.p, ng, v.wo, v.throughput.luminance());
+    merged_[j] = record_at(radiance_, i, v.p, ng, v.wo, v.throughput.luminance() * float(stride));
   });
   std::erase_if(merged_, [](const GuidingRecord& r) {
     return !(r.radiance > 0) || !std::isfinite(r.radiance);
   });
   radiance_records_ += merged_.size();
-  learn(radiance_, merged_, float(stride));
+  const std::span<const GuidingRecord> light_run(merged_);
+  learn(radiance_, {&light_run, 1}, stride);
 
-  merged_.clear();
-  for (const std::vector<GuidingRecord>& r : camera_records_)
-    merged_.insert(merged_.end(), r.begin(), r.end());
-  importance_records_ += merged_.size();
-  learn(importance_, merged_, float(camera_stride_));
+  importance_records_ += camera_records_.size();
+  learn(importance_, camera_records_.runs(), camera_stride_);
 }
 
 void BidirGuiding::make_views(const Scene& scene) {

@@ -30,16 +30,18 @@
 // the BSDF instead of the guide is fixed (--guiding-bsdf-fraction, default 0.5): the records
 // carry no product estimate to learn it from. Memory: each field gets half of --guiding-max-mb.
 //
-// Determinism: records are keyed by (pixel, depth) and by light-vertex index, both independent
-// of threads, and GuidingField::splat sorts them.
+// Determinism: the light vertices' records go to the field in the vertices' order, the camera
+// vertices' in (pixel, depth) order (pixel_records.h), both independent of threads.
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
 
 #include <nlohmann/json.hpp>
+#include <span>
 #include <vector>
 
 #include "guiding/guiding_field.h"
+#include "guiding/pixel_records.h"
 #include "guiding/training_schedule.h"
 #include "image/inverse_variance.h"
 #include "integrators/bidir/light_vertex.h"
@@ -90,7 +92,8 @@ class BidirGuiding {
   // A record of `value` arriving at p (geometric normal ng) along -wo.
   GuidingRecord record_at(const GuidingField& field, uint64_t key, Vec3 p, Vec3 ng, Vec3 wo,
                           float value) const;
-  static void learn(GuidingField& field, std::vector<GuidingRecord>& records, float stride);
+  static void learn(GuidingField& field, std::span<const std::span<const GuidingRecord>> runs,
+                    uint64_t stride);
 
   bool enabled_ = false;
   GuidingField radiance_, importance_;
@@ -98,8 +101,9 @@ class BidirGuiding {
   uint32_t iteration_ = 0;
   uint64_t camera_stride_ = 1;
   uint64_t radiance_records_ = 0, importance_records_ = 0;
-  mutable tbb::enumerable_thread_specific<std::vector<GuidingRecord>> camera_records_;
-  std::vector<GuidingRecord> merged_;
+  uint64_t pixels_ = 0;
+  PixelRecords camera_records_;        // slot: pixel / camera_stride_
+  std::vector<GuidingRecord> merged_;  // the light vertices' records, in their order
   nlohmann::json views_;
 };
 

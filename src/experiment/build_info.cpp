@@ -3,12 +3,11 @@
 #include <fstream>
 #include <thread>
 
-// Defined for this file only by src/CMakeLists.txt, so that a new commit recompiles one file.
+// The build type is defined for this file only by src/CMakeLists.txt; the commit comes from a
+// header the build regenerates when the commit changes (cmake/write_commit.cmake).
+#include "build_commit.h"
 #ifndef CAUSTICA_BUILD_TYPE
 #define CAUSTICA_BUILD_TYPE "unknown"
-#endif
-#ifndef CAUSTICA_GIT_COMMIT
-#define CAUSTICA_GIT_COMMIT "unknown"
 #endif
 
 namespace caustica {

@@ -130,7 +130,9 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     if (!delta) {
       vertex_techniques(scene, it, {si, bsdf, beta, mis, depth, guides}, light_path, rng, arena,
                         acc);
-      if (tech_.guided && guiding_.records_pixel(pixel))
+      // Importance arriving straight from the lens (directly or through specular bounces only)
+      // is what light tracing connects to; a light subpath scattered toward it finds nothing.
+      if (tech_.guided && !specular_path && guiding_.records_pixel(pixel))
         guiding_.record_camera_vertex(pixel, depth, si.p, si.ng, si.wo, beta);
     }
 

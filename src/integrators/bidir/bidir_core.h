@@ -133,6 +133,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
   void report(nlohmann::json& stats) const override;
 
+  // guided-bpt / guided-vcm: the learned fields (tests).
+  const BidirGuiding& guiding() const { return guiding_; }
+
   // adaptive-vcm's probes are shared: every MPI rank renders them, and the means that normalise
   // their variances come from the film of all ranks (observe_film), so every rank makes the
   // choice one process makes.

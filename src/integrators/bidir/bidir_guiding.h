@@ -7,7 +7,11 @@
 //    position from its wo, weighted by its throughput: splatted at wo with the luminance of
 //    its throughput;
 //  - importance: every non-delta camera vertex is a sample of the importance arriving from its
-//    wo (toward the camera), weighted by the camera subpath's throughput.
+//    wo (toward the camera), weighted by the camera subpath's throughput, except where the
+//    camera subpath had only specular bounces before it: importance straight from the lens is
+//    light tracing's to connect to, and a light subpath scattered toward a pinhole finds nothing.
+//    Learned from those vertices too, the guides of visible surfaces pointed at the camera
+//    (door-ajar 320x240, 48 spp, guided-vcm relMSE 0.91 -> 0.80; vcm 1.04).
 // The sums over a directional quadrant are flux estimates, as Müller's L_i / pdf records are;
 // they need no backward pass over the paths. At most kMaxRecords per field and iteration are
 // kept (every k-th vertex, weighted by k, the k-th shifted with the iteration), which bounds the
@@ -86,6 +90,8 @@ class BidirGuiding {
   // importance light subpaths arriving there would be guided by. Kept for report().
   void make_views(const Scene& scene);
   void report(nlohmann::json& stats) const;
+  const GuidingField& radiance() const { return radiance_; }
+  const GuidingField& importance() const { return importance_; }
 
  private:
   friend struct VertexGuides;

@@ -718,5 +718,39 @@ TEST(NamedSpectra, MetalsAndGlassesAreKnown) {
   EXPECT_FALSE(named_spectrum_rgb("metal-Unobtainium-eta"));
 }
 
+// zero_across_surface() promises f() = 0 for wo and wi on opposite sides of the shading plane
+// (the bidirectional core rejects such connections before rebuilding the light vertex). Every
+// material whose BxDF claims it keeps it, in both transport modes; the others do not claim it.
+TEST(Bxdf, ZeroAcrossSurfaceHoldsWhereClaimed) {
+  const std::pair<const char*, MaterialPtr> materials[] = {
+      {"diffuse", make_diffuse(constant(0.8f))},
+      {"rough conductor", rough_conductor_gold(0.3f, 0.1f)},
+      {"smooth conductor", rough_conductor_white(0.f, 0.f)},
+      {"mirror", make_mirror()},
+      {"rough dielectric", rough_dielectric(1.5f, 0.3f)},
+      {"thin dielectric", make_thin_dielectric(1.5f)},
+      {"diffuse transmission", make_diffuse_transmission(constant(0.5f), constant(0.5f))},
+      {"coated diffuse", coated(0.5f, 0.2f)},
+  };
+  int claimed = 0;
+  for (const auto& [name, material] : materials) {
+    const Surface s(material);
+    const bool claims = s.bsdf.zero_across_surface();
+    EXPECT_EQ(claims, !is_transmissive(s.bsdf.flags()) && !s.bsdf.stochastic()) << name;
+    if (!claims) continue;
+    ++claimed;
+    Pcg32 rng(7, 8);
+    for (int i = 0; i < 2000; ++i) {
+      const float theta_o = 89.9f * rng.next_float(), theta_i = 90.01f + 89.9f * rng.next_float();
+      const bool flip = rng.next_float() < 0.5f;
+      const Vec3 wo = s.dir(flip ? 180 - theta_o : theta_o, 6.28f * rng.next_float());
+      const Vec3 wi = s.dir(flip ? 180 - theta_i : theta_i, 6.28f * rng.next_float());
+      for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance})
+        ASSERT_TRUE(s.bsdf.f(wo, wi, mode).is_black()) << name << " at " << i;
+    }
+  }
+  EXPECT_EQ(claimed, 4);  // diffuse, both conductors, the mirror
+}
+
 }  // namespace
 }  // namespace caustica

@@ -21,6 +21,7 @@ class Bsdf {
   uint32_t flags() const { return bxdf_->flags(); }
   bool is_delta() const { return bxdf_->is_delta(); }
   bool stochastic() const { return bxdf_->stochastic(); }
+  bool zero_across_surface() const { return bxdf_->zero_across_surface(); }
   const Frame& shading() const { return shading_; }
   Vec3 ng() const { return ng_; }
   const BxDF* bxdf() const { return bxdf_; }

@@ -72,6 +72,10 @@ class BxDF {
   // only a sample's own weight f |cos| / pdf is exact, so a technique that divides f() by a
   // density of its own (a guided direction, a mixture pdf) must not use this BxDF.
   virtual bool stochastic() const { return false; }
+  // f() is 0 whenever wo and wi lie on opposite sides of the shading plane: true of every BxDF
+  // without transmission whose f() is a value (tests/bsdf_test.cpp checks each). Integrators may
+  // then reject such directions before building anything else.
+  bool zero_across_surface() const { return !is_transmissive(flags()) && !stochastic(); }
 
  protected:
   ~BxDF() = default;

@@ -208,11 +208,23 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
   const SurfaceInteraction& si = cv.si;
   const Bsdf& bsdf = cv.bsdf;
   const int depth = cv.depth;
+  // A light vertex clearly behind a one-sided camera vertex gets f_camera = 0 below: rejected
+  // before its interaction and BSDF are rebuilt. "Clearly": by more than the rounding between
+  // the stored point and the rebuilt one, so that the rebuilt direction lies on the same side
+  // and the connections made are exactly those made without this test.
+  const float wo_side = dot(bsdf.shading().n, si.wo) < 0 ? -1.f : 1.f;
+  const bool one_sided = bsdf.zero_across_surface();
   for (uint32_t i = path_begin_[light_path]; i < path_begin_[light_path + 1]; ++i) {
     const LightVertex& stored = vertices_[i];
     // Stored in increasing depth: once too long, all the rest are too.
     if (light_vertex_depth(stored) + depth > settings_.max_depth) break;
     const LightVertexData v = unpack_light_vertex(stored);
+    if (one_sided) {
+      const float margin =
+          1e-4f * (1 + std::max({std::abs(v.p.x), std::abs(v.p.y), std::abs(v.p.z),
+                                 std::abs(si.p.x), std::abs(si.p.y), std::abs(si.p.z)}));
+      if (wo_side * dot(bsdf.shading().n, v.p - si.p) < -margin) continue;
+    }
     const SurfaceInteraction light_si = scene.interaction_at(v.primitive, v.p, v.wo);
     const Bsdf light_bsdf = light_si.material->bsdf(light_si, arena);
     if (!light_bsdf.valid()) continue;

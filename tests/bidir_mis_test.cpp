@@ -258,15 +258,19 @@ struct Case {
   int connections = 1;       // per camera vertex
   bool pixel_merges = true;  // false: a pixel of adaptive-vcm that does not merge
   bool guided = false;       // guided-bpt / guided-vcm: densities of trained guiding fields
+  bool guide_camera = true, guide_light = true;  // which subpaths (--guiding-subpaths)
 };
 
 // Fields of guided-bpt / guided-vcm trained on synthetic records: surface points hit by rays from
 // random points of the scene's box, with arrival directions biased differently for radiance and
 // importance (so that forward and reverse densities differ), and a spatial threshold low enough
 // that the trees split.
-std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene) {
+std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene, bool guide_camera = true,
+                                              bool guide_light = true) {
   auto g = std::make_unique<BidirGuiding>();
   GuidingSettings settings;
+  settings.guide_camera_paths = guide_camera;
+  settings.guide_light_paths = guide_light;
   settings.spatial_threshold = 200;
   settings.bsdf_fraction = 0.3f;
   g->prepare(scene.bounds(), settings, 6000, 0, 0);  // no budget: it trains forever; 6000 pixels
@@ -304,7 +308,8 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
                               bool filter_densities = false) {
   Pcg32 rng(7, 11);
   ScratchArena arena;
-  const std::unique_ptr<BidirGuiding> guiding = c.guided ? trained_guiding(scene) : nullptr;
+  const std::unique_ptr<BidirGuiding> guiding =
+      c.guided ? trained_guiding(scene, c.guide_camera, c.guide_light) : nullptr;
   int guided_vertices = 0;
   const float light_paths = c.light_paths, radius = 0.02f;
   const bool connect = c.algorithm != BidirAlgorithm::Bpm,
@@ -347,8 +352,11 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
     if (guiding) {
       for (const SurfaceInteraction& si : path.surfaces) {
         const VertexGuides g = guiding->at(si.p, si.ng, si.material->bsdf(si, arena));
-        guided_vertices +=
-            g.guide(TransportMode::Radiance, si.wo) && g.guide(TransportMode::Importance, si.wo);
+        const bool radiance = g.guide(TransportMode::Radiance, si.wo) != nullptr;
+        const bool importance = g.guide(TransportMode::Importance, si.wo) != nullptr;
+        EXPECT_TRUE(c.guide_camera || !radiance) << "an unguided camera side has a guide";
+        EXPECT_TRUE(c.guide_light || !importance) << "an unguided light side has a guide";
+        guided_vertices += (radiance || !c.guide_camera) && (importance || !c.guide_light);
       }
     }
     ASSERT_NEAR(sum, 1.0, 1e-4) << c.scene << " path " << checked << " with " << weights.size()
@@ -405,14 +413,20 @@ INSTANTIATE_TEST_SUITE_P(
         // guided-vcm / guided-bpt: guided densities forward and reverse.
         Case{"cornell", BidirAlgorithm::GuidedVcm, MisHeuristic::Balance, 1024, 1, true, true},
         Case{"mixed-lights", BidirAlgorithm::GuidedVcm, MisHeuristic::Power, 1024, 1, true, true},
-        Case{"corners", BidirAlgorithm::GuidedBpt, MisHeuristic::Balance, 700, 2, true, true}),
+        Case{"corners", BidirAlgorithm::GuidedBpt, MisHeuristic::Balance, 700, 2, true, true},
+        // --guiding-subpaths camera / light: one side guided, the other the BSDF's alone.
+        Case{"cornell", BidirAlgorithm::GuidedVcm, MisHeuristic::Balance, 1024, 1, true, true, true,
+             false},
+        Case{"corners", BidirAlgorithm::GuidedVcm, MisHeuristic::Balance, 700, 1, true, true, false,
+             true}),
     [](const auto& info) {
       std::string n =
           std::string(info.param.scene) + "_" + std::to_string(int(info.param.algorithm)) + "_" +
           (info.param.heuristic == MisHeuristic::Power ? "power" : "balance") + "_N" +
           std::to_string(int(info.param.light_paths)) + "_c" +
           std::to_string(info.param.connections) + (info.param.pixel_merges ? "" : "_nomerge") +
-          (info.param.guided ? "_guided" : "");
+          (info.param.guided ? "_guided" : "") + (info.param.guide_light ? "" : "_camera") +
+          (info.param.guide_camera ? "" : "_light");
       for (char& ch : n)
         if (ch == '-') ch = '_';
       return n;

@@ -31,6 +31,10 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
            "Guiding (guided-pt): what the directional distributions learn, incident radiance "
            "times the cosine to the surface (a product with the cosine) or radiance alone as "
            "Mueller 2017 (default cosine)");
+  o.choice("--guiding-subpaths", &s->guiding_subpaths, {"both", "camera", "light"},
+           "Guiding (guided-bpt, guided-vcm): guide both subpaths, or only camera subpaths (by "
+           "the radiance learned from light vertices) or only light subpaths (by the importance "
+           "learned from camera vertices) (default both)");
   o.choice("--guiding-combine", &s->guiding_combine, {"inverse-variance", "equal"},
            "Guiding: weight the training passes in the image by inverse variance, or every "
            "iteration equally (default inverse-variance)");
@@ -125,6 +129,8 @@ int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene,
   settings->guiding.filter = s.guiding_filter == "on";
   settings->guiding.cosine_product = s.guiding_target == "cosine";
   settings->guiding.inverse_variance = s.guiding_combine == "inverse-variance";
+  settings->guiding.guide_camera_paths = s.guiding_subpaths != "light";
+  settings->guiding.guide_light_paths = s.guiding_subpaths != "camera";
   return 0;
 }
 

@@ -29,6 +29,7 @@ struct SceneSetup {
   int guiding_max_mb = 32;                           // --guiding-max-mb
   std::string guiding_filter = "on";                 // --guiding-filter
   std::string guiding_target = "cosine";             // --guiding-target
+  std::string guiding_subpaths = "both";             // --guiding-subpaths
   std::string guiding_combine = "inverse-variance";  // --guiding-combine
 };
 

@@ -159,11 +159,14 @@ std::string guide_views_html(const ComparisonResult& result) {
       << "learned directional density at the first surface the pixel sees, on the side it is "
       << "seen from (world frame: phi across, cos theta up, +z at the top row; white: densest, "
       << "square root scale).</p>\n";
-    if (views.contains("radiance")) {
-      o << "<p class=\"hint\">Incident radiance (guides camera subpaths):</p>\n"
-        << grid_html(views["radiance"]);
-      o << "<p class=\"hint\">Incident importance (guides light subpaths):</p>\n"
-        << grid_html(views["importance"]);
+    if (views.contains("radiance") || views.contains("importance")) {
+      // guided-bpt/vcm: the fields of the subpaths it guided (--guiding-subpaths).
+      if (views.contains("radiance"))
+        o << "<p class=\"hint\">Incident radiance (guides camera subpaths):</p>\n"
+          << grid_html(views["radiance"]);
+      if (views.contains("importance"))
+        o << "<p class=\"hint\">Incident importance (guides light subpaths):</p>\n"
+          << grid_html(views["importance"]);
     } else {
       o << "<p class=\"hint\">Incident radiance:</p>\n" << grid_html(views);
     }

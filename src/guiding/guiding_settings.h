@@ -37,6 +37,10 @@ struct GuidingSettings {
   // with the cosine at no cost: a leaf's points share a side class, so their normals are alike,
   // and on a diffuse surface it is the product with the whole BSDF.
   bool cosine_product = true;
+  // guided-bpt / guided-vcm: which subpaths are guided (the other samples its BSDF alone, and
+  // its field is neither learned nor looked up). door-ajar 320x240, 48 spp, 2 threads, relMSE
+  // per sample: camera 0.86, light 1.04, both 0.80 (vcm 1.04).
+  bool guide_camera_paths = true, guide_light_paths = true;
   // Rendering passes enter the image weighted by their inverse variance (Müller 2019); false:
   // every iteration with equal weight.
   bool inverse_variance = true;

@@ -22,7 +22,9 @@ void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint
                            int spp, double seconds) {
   enabled_ = true;
   if (settings.bsdf_fraction < 0) settings.bsdf_fraction = kDefaultBsdfFraction;
-  settings.max_bytes /= 2;
+  guide_camera_ = settings.guide_camera_paths;
+  guide_light_ = settings.guide_light_paths;
+  if (guide_camera_ && guide_light_) settings.max_bytes /= 2;
   radiance_ = GuidingField(bounds, settings, /*sided=*/true);
   importance_ = GuidingField(bounds, settings, /*sided=*/true);
   schedule_ = TrainingSchedule(spp, seconds);
@@ -66,14 +68,19 @@ VertexGuides BidirGuiding::at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const {
 void VertexGuides::resolve(int side) const {
   const int front = GuidingField::side_class(n);
   const int c = side ? front ^ 1 : front;  // -n: the same axis, the other sign
-  const GuidingField& radiance = fields->radiance_;
-  const GuidingField& importance = fields->importance_;
-  const GuidingField::Guide& r = radiance.guide(radiance.leaf_at(p, c));
-  const GuidingField::Guide& i = importance.guide(importance.leaf_at(p, c));
-  guides[int(TransportMode::Radiance)][side] = r.distribution;
-  bsdf[int(TransportMode::Radiance)][side] = r.bsdf_fraction;
-  guides[int(TransportMode::Importance)][side] = i.distribution;
-  bsdf[int(TransportMode::Importance)][side] = i.bsdf_fraction;
+  // A subpath that is not guided keeps no guide (its densities are the BSDF's).
+  if (fields->guide_camera_) {
+    const GuidingField& radiance = fields->radiance_;
+    const GuidingField::Guide& r = radiance.guide(radiance.leaf_at(p, c));
+    guides[int(TransportMode::Radiance)][side] = r.distribution;
+    bsdf[int(TransportMode::Radiance)][side] = r.bsdf_fraction;
+  }
+  if (fields->guide_light_) {
+    const GuidingField& importance = fields->importance_;
+    const GuidingField::Guide& i = importance.guide(importance.leaf_at(p, c));
+    guides[int(TransportMode::Importance)][side] = i.distribution;
+    bsdf[int(TransportMode::Importance)][side] = i.bsdf_fraction;
+  }
   resolved |= uint8_t(1u << side);
 }
 
@@ -120,6 +127,11 @@ void BidirGuiding::learn(GuidingField& field, std::span<const std::span<const Gu
 void BidirGuiding::end_iteration(const Scene& scene,
                                  const std::vector<LightVertex>& light_vertices) {
   if (!schedule_.learning()) return;
+  if (guide_light_) {
+    importance_records_ += camera_records_.size();
+    learn(importance_, camera_records_.runs(), camera_stride_);
+  }
+  if (!guide_camera_) return;
   // Radiance from the light vertices: every k-th one, shifted by the iteration.
   const size_t n = light_vertices.size();
   const size_t stride = std::max<size_t>(1, (n + kMaxRecords - 1) / kMaxRecords);
@@ -138,19 +150,17 @@ void BidirGuiding::end_iteration(const Scene& scene,
   radiance_records_ += merged_.size();
   const std::span<const GuidingRecord> light_run(merged_);
   learn(radiance_, {&light_run, 1}, stride);
-
-  importance_records_ += camera_records_.size();
-  learn(importance_, camera_records_.runs(), camera_stride_);
 }
 
 void BidirGuiding::make_views(const Scene& scene) {
-  views_ = {{"radiance", guide_views(scene,
-                                     [&](Vec3 p, int side) {
-                                       return &radiance_.sampling(radiance_.leaf_at(p, side));
-                                     })},
-            {"importance", guide_views(scene, [&](Vec3 p, int side) {
-               return &importance_.sampling(importance_.leaf_at(p, side));
-             })}};
+  views_ = nlohmann::json::object();
+  if (guide_camera_)
+    views_["radiance"] = guide_views(
+        scene, [&](Vec3 p, int side) { return &radiance_.sampling(radiance_.leaf_at(p, side)); });
+  if (guide_light_)
+    views_["importance"] = guide_views(scene, [&](Vec3 p, int side) {
+      return &importance_.sampling(importance_.leaf_at(p, side));
+    });
 }
 
 void BidirGuiding::report(nlohmann::json& stats) const {
@@ -161,7 +171,10 @@ void BidirGuiding::report(nlohmann::json& stats) const {
   g["radiance_guiding_bytes"] = radiance_.memory_bytes();
   g["importance_guiding_bytes"] = importance_.memory_bytes();
   g["guiding_bytes"] = radiance_.memory_bytes() + importance_.memory_bytes();
-  g["guiding_max_bytes"] = 2 * radiance_.settings().max_bytes;
+  g["guiding_max_bytes"] = (guide_camera_ && guide_light_ ? 2 : 1) * radiance_.settings().max_bytes;
+  g["guided_subpaths"] = guide_camera_ && guide_light_ ? "both"
+                         : guide_camera_               ? "camera"
+                                                       : "light";
   g["radiance_records"] = radiance_records_;
   g["importance_records"] = importance_records_;
   g["bsdf_fraction"] = radiance_.settings().bsdf_fraction;

@@ -77,7 +77,7 @@ class BidirGuiding {
 
   // Camera vertices of `pixel` are recorded this iteration (one pixel in k, while training).
   bool records_pixel(uint64_t pixel) const {
-    return schedule_.learning() && (pixel + iteration_) % camera_stride_ == 0;
+    return guide_light_ && schedule_.learning() && (pixel + iteration_) % camera_stride_ == 0;
   }
   // The camera subpath of `pixel` reached a non-delta vertex at p (geometric normal ng),
   // arriving along -wo with throughput beta (from estimate(): any thread).
@@ -102,6 +102,7 @@ class BidirGuiding {
                     uint64_t stride);
 
   bool enabled_ = false;
+  bool guide_camera_ = true, guide_light_ = true;  // GuidingSettings::guide_*_paths
   GuidingField radiance_, importance_;
   TrainingSchedule schedule_;
   uint32_t iteration_ = 0;

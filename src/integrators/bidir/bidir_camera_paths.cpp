@@ -214,6 +214,7 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
   // and the connections made are exactly those made without this test.
   const float wo_side = dot(bsdf.shading().n, si.wo) < 0 ? -1.f : 1.f;
   const bool one_sided = bsdf.zero_across_surface();
+  const float camera_extent = std::max({std::abs(si.p.x), std::abs(si.p.y), std::abs(si.p.z)});
   for (uint32_t i = path_begin_[light_path]; i < path_begin_[light_path + 1]; ++i) {
     const LightVertex& stored = vertices_[i];
     // Stored in increasing depth: once too long, all the rest are too.
@@ -221,8 +222,8 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
     const LightVertexData v = unpack_light_vertex(stored);
     if (one_sided) {
       const float margin =
-          1e-4f * (1 + std::max({std::abs(v.p.x), std::abs(v.p.y), std::abs(v.p.z),
-                                 std::abs(si.p.x), std::abs(si.p.y), std::abs(si.p.z)}));
+          1e-4f *
+          (1 + std::max({camera_extent, std::abs(v.p.x), std::abs(v.p.y), std::abs(v.p.z)}));
       if (wo_side * dot(bsdf.shading().n, v.p - si.p) < -margin) continue;
     }
     const SurfaceInteraction light_si = scene.interaction_at(v.primitive, v.p, v.wo);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #include "integrators/bidir/bidir_core.h"
 #include "integrators/bidir/subpath_step.h"
@@ -198,13 +199,14 @@ void BidirIntegrator::connect_to_light_paths(const Scene& scene, const Iteration
   for (int j = 0; j < c; ++j) {
     const uint64_t path =
         j == 0 ? light_path : std::min<uint64_t>(uint64_t(rng.next_float() * double(n)), n - 1);
-    connect_to_light_path(scene, rules, v, scaled, path, arena, acc);
+    connect_to_light_path(scene, rules, v, scaled, path, j == 0, arena, acc);
   }
 }
 
 void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& rules,
                                             const CameraVertex& cv, Rgb beta, uint64_t light_path,
-                                            ScratchArena& arena, PixelAccumulator& acc) const {
+                                            bool own, ScratchArena& arena,
+                                            PixelAccumulator& acc) const {
   const SurfaceInteraction& si = cv.si;
   const Bsdf& bsdf = cv.bsdf;
   const int depth = cv.depth;
@@ -215,7 +217,14 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
   const float wo_side = dot(bsdf.shading().n, si.wo) < 0 ? -1.f : 1.f;
   const bool one_sided = bsdf.zero_across_surface();
   const float camera_extent = std::max({std::abs(si.p.x), std::abs(si.p.y), std::abs(si.p.z)});
-  for (uint32_t i = path_begin_[light_path]; i < path_begin_[light_path + 1]; ++i) {
+  const uint32_t first = path_begin_[light_path], end = path_begin_[light_path + 1];
+  if (own && !acc.own_path && end > first) {
+    acc.own_path = static_cast<RebuiltLightVertex*>(
+        arena.allocate(sizeof(RebuiltLightVertex) * (end - first), alignof(RebuiltLightVertex)));
+    std::uninitialized_default_construct_n(acc.own_path, end - first);
+  }
+  RebuiltLightVertex scratch;  // a vertex of another light path, rebuilt for this connection
+  for (uint32_t i = first; i < end; ++i) {
     const LightVertex& stored = vertices_[i];
     // Stored in increasing depth: once too long, all the rest are too.
     if (light_vertex_depth(stored) + depth > settings_.max_depth) break;
@@ -226,8 +235,17 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
           (1 + std::max({camera_extent, std::abs(v.p.x), std::abs(v.p.y), std::abs(v.p.z)}));
       if (wo_side * dot(bsdf.shading().n, v.p - si.p) < -margin) continue;
     }
-    const SurfaceInteraction light_si = scene.interaction_at(v.primitive, v.p, v.wo);
-    const Bsdf light_bsdf = light_si.material->bsdf(light_si, arena);
+    RebuiltLightVertex& rebuilt = own ? acc.own_path[i - first] : scratch;
+    if (!own || !rebuilt.built) {
+      rebuilt.si = scene.interaction_at(v.primitive, v.p, v.wo);
+      rebuilt.bsdf = rebuilt.si.material->bsdf(rebuilt.si, arena);
+      rebuilt.guides = tech_.guided && rebuilt.bsdf.valid()
+                           ? guiding_.at(rebuilt.si.p, rebuilt.si.ng, rebuilt.bsdf)
+                           : VertexGuides{};
+      rebuilt.built = true;
+    }
+    const SurfaceInteraction& light_si = rebuilt.si;
+    const Bsdf& light_bsdf = rebuilt.bsdf;
     if (!light_bsdf.valid()) continue;
     const Vec3 d = light_si.p - si.p;
     const float dist2 = length_squared(d);
@@ -239,10 +257,8 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
         light_bsdf.f(v.wo, -dir, TransportMode::Importance) * light_bsdf.abs_cos(dir);
     if (f_light.is_black()) continue;
     ++acc.work.connections;
-    const VertexGuides light_guides =
-        tech_.guided ? guiding_.at(light_si.p, light_si.ng, light_bsdf) : VertexGuides{};
     const TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si,
-                                                  bsdf, cv.mis, light_guides, cv.guides);
+                                                  bsdf, cv.mis, rebuilt.guides, cv.guides);
     const float w = terms.weight(rules.counts());
     const Rgb value = beta * v.throughput * f_camera * f_light * (w / dist2);
     if (value.is_black()) continue;

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <nlohmann/json.hpp>
+#include <type_traits>
 #include <vector>
 
 #include "core/arena.h"
@@ -81,8 +82,22 @@ struct Iteration {
 };
 
 // A value added to the pixel and, if technique images are kept, to its technique.
+// A light vertex rebuilt for connections: its interaction and BSDF (from the stored vertex) and
+// its guides. The vertices of the pixel's own light path are rebuilt once and kept for every
+// camera vertex of the pixel (PixelAccumulator::own_path), not once per camera vertex.
+struct RebuiltLightVertex {
+  SurfaceInteraction si;
+  Bsdf bsdf;
+  VertexGuides guides;
+  bool built = false;
+};
+static_assert(std::is_trivially_destructible_v<RebuiltLightVertex>,
+              "arena memory is not destroyed");
+
 struct PixelAccumulator {
   Rgb sum;
+  // The pixel's own light path rebuilt so far (arena memory, one entry per stored vertex).
+  RebuiltLightVertex* own_path = nullptr;
   TechniqueImages* techniques = nullptr;
   size_t pixel = 0;
   uint64_t nonfinite = 0;
@@ -215,9 +230,10 @@ class BidirIntegrator final : public CameraPathIntegrator {
                               const CameraVertex& v, uint64_t light_path, Pcg32& rng,
                               ScratchArena& arena, PixelAccumulator& acc) const;
 
-  // beta: the camera vertex's throughput over the connections per vertex.
+  // beta: the camera vertex's throughput over the connections per vertex. own: light_path is
+  // the pixel's own (its rebuilt vertices are kept in acc for the pixel's other camera vertices).
   void connect_to_light_path(const Scene& scene, const MisRules& rules, const CameraVertex& v,
-                             Rgb beta, uint64_t light_path, ScratchArena& arena,
+                             Rgb beta, uint64_t light_path, bool own, ScratchArena& arena,
                              PixelAccumulator& acc) const;
 
   // Merging accepts a photon only if light could have reached the query's surface through it

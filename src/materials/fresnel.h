@@ -3,6 +3,7 @@
 // `eta` is the IOR of the -z side over that of the +z side (interior over exterior).
 #pragma once
 
+#include <algorithm>
 #include <complex>
 
 #include "core/rgb.h"
@@ -29,16 +30,24 @@ inline float fr_dielectric(float cos_i, float eta) {
   return (r_parl * r_parl + r_perp * r_perp) / 2;
 }
 
-// Fresnel reflectance of a conductor with complex IOR eta + i k (pbrt-v4 FrComplex).
-inline float fr_complex(float cos_i, std::complex<float> eta) {
-  using C = std::complex<float>;
+// Fresnel reflectance of a conductor with complex IOR eta + i k: the value of pbrt-v4's FrComplex
+// (unpolarised, |r_parallel|^2 and |r_perpendicular|^2 averaged) in real arithmetic, as pbrt-v3's
+// FrConductor writes it. std::complex<float> spent half of a rough conductor's f() in the
+// library's Annex G division and csqrtf (287 ns per f + pdf, BM_RoughConductorEval); the test
+// Fresnel.ConductorMatchesComplexArithmetic compares the two.
+inline float fr_complex(float cos_i, std::complex<float> eta_k) {
   cos_i = clamp(cos_i, 0.f, 1.f);
-  const float sin2_i = 1 - cos_i * cos_i;
-  const C sin2_t = sin2_i / (eta * eta);
-  const C cos_t = std::sqrt(C(1.f) - sin2_t);
-  const C r_parl = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-  const C r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-  return (std::norm(r_parl) + std::norm(r_perp)) / 2;
+  if (cos_i == 0) return 1;  // grazing
+  const float eta = eta_k.real(), k = eta_k.imag();
+  const float cos2 = cos_i * cos_i, sin2 = 1 - cos2;
+  const float t0 = eta * eta - k * k - sin2;
+  const float a2b2 = std::sqrt(std::max(0.f, t0 * t0 + 4 * eta * eta * k * k));
+  const float a = std::sqrt(std::max(0.f, 0.5f * (a2b2 + t0)));
+  const float t1 = a2b2 + cos2, t2 = 2 * a * cos_i;
+  const float r_perp = (t1 - t2) / (t1 + t2);
+  const float t3 = cos2 * a2b2 + sin2 * sin2, t4 = t2 * sin2;
+  const float r_parl = r_perp * (t3 - t4) / (t3 + t4);
+  return 0.5f * (r_parl + r_perp);
 }
 inline Rgb fr_complex(float cos_i, Rgb eta, Rgb k) {
   return {fr_complex(cos_i, {eta.r, k.r}), fr_complex(cos_i, {eta.g, k.g}),

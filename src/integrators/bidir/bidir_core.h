@@ -81,7 +81,6 @@ struct Iteration {
   LightPathAssignment light_path_of;  // pixel -> the light subpath it connects to
 };
 
-// A value added to the pixel and, if technique images are kept, to its technique.
 // A light vertex rebuilt for connections: its interaction and BSDF (from the stored vertex) and
 // its guides. The vertices of the pixel's own light path are rebuilt once and kept for every
 // camera vertex of the pixel (PixelAccumulator::own_path), not once per camera vertex.
@@ -94,6 +93,7 @@ struct RebuiltLightVertex {
 static_assert(std::is_trivially_destructible_v<RebuiltLightVertex>,
               "arena memory is not destroyed");
 
+// A value added to the pixel and, if technique images are kept, to its technique.
 struct PixelAccumulator {
   Rgb sum;
   // The pixel's own light path rebuilt so far (arena memory, one entry per stored vertex).

@@ -211,12 +211,12 @@ void BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
   const float scale =
       cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(it.plan.light_paths));
   const size_t first_splat = chunk.splats.size();
+  const LensConnection lens = lens_connection(camera, si, bsdf, si.wo, cs->p_lens, guides);
   filter_.for_each_pixel(
       cs->raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
         const uint32_t pixel = uint32_t(y * camera.width() + x);
         const MisRules& rules = it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
-        const TechniqueTerms terms =
-            terms_light_to_camera(rules, camera, si, bsdf, si.wo, mis, cs->p_lens, fs.pdf, guides);
+        const TechniqueTerms terms = terms_light_to_camera(rules, lens, mis, fs.pdf);
         const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
         const Rgb value = beta * f * (scale * w) * (fs.weight * fs.pdf);
         if (value.is_black()) return;

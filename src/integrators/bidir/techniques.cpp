@@ -95,17 +95,33 @@ TechniqueTerms terms_connection(const MisRules& rules, const SurfaceInteraction&
   return rules.connect(light, camera, camera_pdf_a, camera_rev, light_pdf_a, light_rev);
 }
 
+LensConnection lens_connection(const Camera& camera, const SurfaceInteraction& si, const Bsdf& bsdf,
+                               Vec3 wo, Vec3 p_lens, const VertexGuides& guides) {
+  const Vec3 d = p_lens - si.p;
+  LensConnection c;
+  c.dist2 = length_squared(d);
+  const Vec3 dir = d / std::sqrt(c.dist2);
+  float pdf_pos, pdf_dir;
+  camera.pdf_we(p_lens, -dir, &pdf_pos, &pdf_dir);
+  c.pixels_pdf_dir = float(camera.pixel_count()) * pdf_dir;
+  c.cos_at_vertex = geometric_cos(si, dir);
+  c.rev = direction_pdf(bsdf, guides, dir, wo, TransportMode::Radiance);
+  return c;
+}
+
+TechniqueTerms terms_light_to_camera(const MisRules& rules, const LensConnection& c,
+                                     const MisSums& light, float raster_density) {
+  // camera_pdf_w's value (pixel_count x pdf_dir x raster density), in its order of operations.
+  const float camera_pdf_a = c.pixels_pdf_dir * raster_density * c.cos_at_vertex / c.dist2;
+  return rules.light_to_camera(light, camera_pdf_a, c.rev);
+}
+
 TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera,
                                      const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
                                      const MisSums& light, Vec3 p_lens, float raster_density,
                                      const VertexGuides& guides) {
-  const Vec3 d = p_lens - si.p;
-  const float dist2 = length_squared(d);
-  const Vec3 dir = d / std::sqrt(dist2);
-  const float camera_pdf_a =
-      camera_pdf_w(camera, p_lens, -dir, raster_density) * geometric_cos(si, dir) / dist2;
-  const float rev = direction_pdf(bsdf, guides, dir, wo, TransportMode::Radiance);
-  return rules.light_to_camera(light, camera_pdf_a, rev);
+  return terms_light_to_camera(rules, lens_connection(camera, si, bsdf, wo, p_lens, guides), light,
+                               raster_density);
 }
 
 TechniqueTerms terms_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,

@@ -55,7 +55,19 @@ TechniqueTerms terms_connection(const MisRules& rules, const SurfaceInteraction&
                                 const MisSums& camera, const VertexGuides& light_guides = {},
                                 const VertexGuides& camera_guides = {});
 // Light vertex connected to the lens point p_lens, splatted to a pixel whose camera technique
-// has raster density raster_density there (camera_pdf_w).
+// has raster density raster_density there (camera_pdf_w). A splat reaches every pixel the filter
+// covers (up to 16 for pbrt-v4's default Gaussian): what does not depend on the pixel is
+// computed once (LensConnection), the terms per pixel from it.
+struct LensConnection {
+  float pixels_pdf_dir = 0;  // pixel_count x the camera's pdf_we direction density
+  float cos_at_vertex = 0;   // |cos| at the light vertex, with its geometric normal
+  float dist2 = 0;
+  float rev = 0;  // the density of a camera subpath leaving the light vertex toward wo
+};
+LensConnection lens_connection(const Camera& camera, const SurfaceInteraction& si, const Bsdf& bsdf,
+                               Vec3 wo, Vec3 p_lens, const VertexGuides& guides = {});
+TechniqueTerms terms_light_to_camera(const MisRules& rules, const LensConnection& c,
+                                     const MisSums& light, float raster_density = 1.f);
 TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera,
                                      const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
                                      const MisSums& light, Vec3 p_lens, float raster_density = 1.f,

@@ -73,7 +73,8 @@ class BxDF {
   // density of its own (a guided direction, a mixture pdf) must not use this BxDF.
   virtual bool stochastic() const { return false; }
   // f() is 0 whenever wo and wi lie on opposite sides of the shading plane: true of every BxDF
-  // without transmission whose f() is a value (tests/bsdf_test.cpp checks each). Integrators may
+  // without transmission whose f() is a value (Bxdf.ZeroAcrossSurfaceHoldsWhereClaimed in
+  // tests/materials_test.cpp checks each). Integrators may
   // then reject such directions before building anything else.
   bool zero_across_surface() const { return !is_transmissive(flags()) && !stochastic(); }
 

@@ -74,8 +74,8 @@ class BxDF {
   virtual bool stochastic() const { return false; }
   // f() is 0 whenever wo and wi lie on opposite sides of the shading plane: true of every BxDF
   // without transmission whose f() is a value (Bxdf.ZeroAcrossSurfaceHoldsWhereClaimed in
-  // tests/materials_test.cpp checks each). Integrators may
-  // then reject such directions before building anything else.
+  // tests/materials_test.cpp checks each). Integrators may then reject such directions before
+  // building anything else.
   bool zero_across_surface() const { return !is_transmissive(flags()) && !stochastic(); }
 
  protected:

@@ -36,7 +36,7 @@ struct CostModel {
   double photon = 0.03;       // one photon gathered
 };
 constexpr float kLightPathFactors[] = {0.25f, 0.5f, 1.f, 2.f};
-constexpr int kConnections[] = {0, 1, 2, 4};
+constexpr int kConnections[] = {0, 1, 2, 4, 8};
 constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
 constexpr int kBlurRadius = 3;        // pixel variances pooled over 7 x 7 (box_blur)
 constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
@@ -106,7 +106,8 @@ void for_pixel_blocks(size_t n, Fn&& fn) {
 // Per pixel and iteration, from the probes' work (light paths at one per pixel).
 struct PixelWork {
   // connections: light vertices connected per pixel with one connection per camera vertex
-  // (the probes': depth limits and early rejections make it far fewer than vertices x vertices).
+  // (from the probes', which make two: depth limits and early rejections make it far fewer than
+  // vertices x vertices).
   double camera_vertices, connections, light_vertices_per_path, merge_queries, photons;
 };
 
@@ -163,7 +164,7 @@ IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
   if (is_probe(iteration)) {
     IterationPlan p;
     p.light_paths = pixels_;
-    p.connections = 1;
+    p.connections = kProbeConnections;
     p.merge_everywhere = true;
     p.probe = true;
     return p;
@@ -187,10 +188,10 @@ void AdaptivePlan::begin_probe(float radius) {
 }
 
 void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* terms,
-                       const MisCounts& counts) const {
+                       const MisCounts& counts, Share share) const {
   if (!(value != 0.f) || !std::isfinite(value)) return;
   if (!terms) {
-    for (size_t j = 0; j < kCandidates; ++j) sums.a[j] += value;
+    for (size_t j = 0; j < kCandidates; ++j) sums.r[j] += value;
     return;
   }
   // The probe's counts are all positive, so a finite Q means finite terms: plain arithmetic.
@@ -208,9 +209,21 @@ void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* t
       continue;
     }
     const float ratio = q / q_candidate;
-    const float g = value * ratio * (own_count[j] * inv_own);
-    sums.a[j] += g;
-    sums.d[j] += f2 * ratio - g * g;
+    sums.d[j] += f2 * ratio;
+    if (share == Share::None) {
+      const float g = value * ratio * (own_count[j] * inv_own);
+      sums.r[j] += g;
+      sums.d[j] -= g * g;
+    } else if (own_count[j] > 0) {  // one of the candidate's connections (if it makes any)
+      const float g = value * ratio;
+      if (share == Share::OwnLightPath) {
+        sums.s0[j] += g;
+        sums.d[j] -= g * g;
+      } else {
+        sums.s1[j] += g;
+        sums.d[j] -= (own_count[j] - 1) * g * g;
+      }
+    }
   }
 }
 
@@ -218,20 +231,24 @@ void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTer
                                    const MisCounts& counts) {
   CandidateSums sums = pixel_start(pixel);
   add(sums, value, terms, counts);
-  std::copy(sums.a.begin(), sums.a.end(), light_sums_.begin() + pixel * kCandidates);
+  std::copy(sums.r.begin(), sums.r.end(), light_sums_.begin() + pixel * kCandidates);
   float* m = &moments_[pixel * kCandidates];
   for (size_t j = 0; j < kCandidates; ++j) m[j] += sums.d[j];
 }
 
 AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
   CandidateSums sums;
-  std::copy_n(light_sums_.begin() + pixel * kCandidates, kCandidates, sums.a.begin());
+  std::copy_n(light_sums_.begin() + pixel * kCandidates, kCandidates, sums.r.begin());
   return sums;
 }
 
 void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums) {
   float* m = &moments_[pixel * kCandidates];
-  for (size_t j = 0; j < kCandidates; ++j) m[j] += sums.a[j] * sums.a[j] + sums.d[j];
+  for (size_t j = 0; j < kCandidates; ++j) {
+    const float c = table_.connect[j], r = sums.r[j], s0 = sums.s0[j], s1 = sums.s1[j];
+    m[j] += r * r + 2 * r * (s0 + (c - 1) * s1) + s0 * s0 + (c - 1) * s1 * s1 +
+            c * (c - 1) * s0 * s1 + sums.d[j];
+  }
 }
 
 void add_counts(ProbeWork& total, const ProbeWork& w) {
@@ -300,7 +317,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   const size_t k = list.size();
   const double probes = double(probes_), pixels = double(pixels_);
   const PixelWork pw{work_.camera_vertices / (probes * pixels),
-                     work_.connections / (probes * pixels),
+                     work_.connections / (probes * pixels * kProbeConnections),
                      work_.light_paths > 0 ? work_.light_vertices / work_.light_paths : 0.0,
                      work_.merge_queries / (probes * pixels), work_.photons / (probes * pixels)};
   const CostModel t = costs_of(work_, measured_);

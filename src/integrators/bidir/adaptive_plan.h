@@ -4,14 +4,17 @@
 //
 // A configuration is the number of light paths per iteration (0: path tracing with NEE and MIS,
 // up to 2x the pixel count), the number of light paths each camera vertex connects to
-// (0, 1, 2, 4) and, per pixel, whether the camera vertices merge. Probe iterations render full
-// VCM (one light path per pixel, one connection, merging everywhere) and record every
-// contribution F of every pixel with its MIS terms. Under the balance heuristic the second
+// (0, 1, 2, 4, 8) and, per pixel, whether the camera vertices merge. Probe iterations render full
+// VCM (one light path per pixel, two connections per camera vertex: the pixel's own light path
+// and one drawn at random, merging everywhere) and record every contribution F of every pixel
+// with its MIS terms. Under the balance heuristic the second
 // moment of a pixel under counts n' is the integral of f^2 / sum_k n'_k p_k; the probe's samples
 // estimate it as sum F^2 * Q / Q', where Q and Q' are the MIS denominators of the sample's path
 // under the probe's and the candidate's counts (mis.h: TechniqueTerms::denominator). That is
 // the paper's proxy-weight correction factor: one probe prices every candidate, including ones
-// it never rendered. Correlation between techniques sharing a camera prefix is ignored.
+// it never rendered. The cross terms of contributions that share a camera prefix are kept
+// (AdaptivePlan::add); the probe's two connections per vertex tell those that share the
+// pixel's light path from those that do not.
 //
 // Cost: per candidate, the predicted time of an iteration from the probes' counts (camera
 // vertices, light vertices, connections, merge queries and photons) times per-operation costs,
@@ -77,24 +80,35 @@ class AdaptivePlan {
 
   // Recording a probe. A pixel's estimate in a probe is the sum of its contributions F_i, each
   // from a technique t_i of the probe's counts n. Under candidate counts n' the same path has
-  // the balance denominator Q'_i instead of Q_i. Per candidate the pixel keeps
-  //   A = sum G_i,  G_i = F_i (Q_i / Q'_i) (n'_t / n_t)  (mean-preserving: E[A] = the pixel value)
-  //   D = sum (F_i^2 Q_i / Q'_i - G_i^2)
-  // and A^2 + D estimates the candidate's second moment: its diagonal is the proxy correction
-  // sum F^2 Q / Q' (exact for independent samples), its cross terms those of the reweighted
-  // contributions, which share the camera path as the candidate's would. For the probe's own
-  // counts it is the sample's (sum F)^2. Light-tracing splats come first (add_light_trace, in a
-  // fixed order), then the pixel's task continues from pixel_start() with add() and hands the
-  // sums back with pixel_end().
-  static constexpr size_t kCandidates = 33;
+  // the balance denominator Q'_i instead of Q_i; G_i = F_i Q_i / Q'_i is its contribution
+  // under the candidate. Per candidate the pixel keeps
+  //   R  = sum over contributions other than connections of G_i (n'_t / n_t)
+  //   S0 = sum over connections to the pixel's own light path of G_i   (one per camera vertex)
+  //   S1 = sum over connections to a light path drawn at random of G_i (one per camera vertex)
+  //   D  = sum F_i^2 Q_i / Q'_i - (the squares of the G_i as they enter below)
+  // A candidate with c' connections connects each camera vertex to the pixel's light path and
+  // c' - 1 random ones: its pair of two vertices' connections shares a light path in 1 of c'^2
+  // pairs, and a vertex's own c' connections are c'(c' - 1) independent pairs. Its second
+  // moment is estimated by
+  //   R^2 + 2 R (S0 + (c' - 1) S1) + S0^2 + (c' - 1) S1^2 + c'(c' - 1) S0 S1 + D
+  // (each kind of pair at its count; Grittmann et al. 2022 scale one connection by c', which
+  // counts every pair as sharing the light path and over-predicts many connections). The
+  // diagonal is the proxy correction sum F^2 Q / Q' (exact for independent samples). For the
+  // probe's own counts it is the sample's (sum F)^2. Light-tracing splats come first
+  // (add_light_trace, in a fixed order), then the pixel's task continues from pixel_start()
+  // with add() and hands the sums back with pixel_end().
+  static constexpr size_t kCandidates = 41;
+  static constexpr int kProbeConnections = 2;  // the pixel's own light path and a random one
+  enum class Share { None, OwnLightPath, RandomLightPath };  // of a connection
   struct CandidateSums {
-    std::array<float, kCandidates> a{}, d{};
+    std::array<float, kCandidates> r{}, s0{}, s1{}, d{};
   };
   // radius: the probe's merge radius (the candidates' merge counts N' pi r^2).
   void begin_probe(float radius);
   // terms == nullptr: a path only one technique makes (the same F under every candidate).
-  void add(CandidateSums& sums, float value, const TechniqueTerms* terms,
-           const MisCounts& counts) const;
+  // share: which light path a connection went to (None for every other technique).
+  void add(CandidateSums& sums, float value, const TechniqueTerms* terms, const MisCounts& counts,
+           Share share = Share::None) const;
   void add_light_trace(size_t pixel, float value, const TechniqueTerms* terms,
                        const MisCounts& counts);
   CandidateSums pixel_start(size_t pixel) const;
@@ -131,7 +145,7 @@ class AdaptivePlan {
   bool measured_ = false;
   bool probe_all_ = false;
   std::vector<float> moments_;     // pixels x candidates: sum over probes of A^2 + D
-  std::vector<float> light_sums_;  // pixels x candidates: this probe's light-tracing A
+  std::vector<float> light_sums_;  // pixels x candidates: this probe's light-tracing R
   // The candidates' counts per class for this probe's radius (structure of arrays).
   struct CountTable {
     std::array<float, kCandidates> emitter{}, light_trace{}, connect{}, merge{};

@@ -263,7 +263,8 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
     const Rgb value = beta * v.throughput * f_camera * f_light * (w / dist2);
     if (value.is_black()) continue;
     if (scene.occluded(spawn_ray_between(si, light_si))) continue;
-    acc.add(false, v.depth + 1, depth + 1, value, &terms);
+    acc.add(false, v.depth + 1, depth + 1, value, &terms,
+            own ? AdaptivePlan::Share::OwnLightPath : AdaptivePlan::Share::RandomLightPath);
   }
 }
 

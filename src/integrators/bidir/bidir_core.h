@@ -109,8 +109,10 @@ struct PixelAccumulator {
   ProbeWork work;
   // sum is the estimate before the filter weight (the seam applies it); technique images get
   // each value already weighted, so that they add up to the image. terms: the value's MIS
-  // terms (nullptr: a path only one technique makes).
-  void add(bool merge, int s, int t, Rgb value, const TechniqueTerms* terms = nullptr) {
+  // terms (nullptr: a path only one technique makes); share: for a connection, whether it went
+  // to the pixel's own light path (AdaptivePlan::add).
+  void add(bool merge, int s, int t, Rgb value, const TechniqueTerms* terms = nullptr,
+           AdaptivePlan::Share share = AdaptivePlan::Share::None) {
     if (!value.is_finite()) {
       ++nonfinite;
       return;
@@ -118,7 +120,8 @@ struct PixelAccumulator {
     sum += value;
     if (techniques)
       techniques->add(TechniqueImages::key(merge, s, t), pixel, value * filter_weight);
-    if (plan) plan->add(candidate_sums, scalar(value * filter_weight), terms, rules->counts());
+    if (plan)
+      plan->add(candidate_sums, scalar(value * filter_weight), terms, rules->counts(), share);
   }
 };
 

@@ -2,7 +2,9 @@
 
 #include <bit>
 #include <cmath>
+#include <limits>
 
+#include "core/bfloat16.h"
 #include "core/distribution.h"
 #include "core/frame.h"
 #include "core/math.h"
@@ -168,3 +170,25 @@ TEST(NextFloat, MatchesStdNextafterEverywhere) {
 
 }  // namespace
 }  // namespace caustica
+
+// bfloat16 (core/bfloat16.h): round to nearest even within 2^-8, float's range, infinities and
+// NaN kept. A truncating conversion (bits >> 16) fails the ties and the error bound.
+TEST(BFloat16, RoundsToNearestEvenAndKeepsTheRange) {
+  EXPECT_EQ(from_bfloat16(to_bfloat16(1.f)), 1.f);
+  // 1 + 2^-8 lies halfway between 1 and 1 + 2^-7: ties to the even 1; 1 + 3 * 2^-8 to 1 + 2^-6.
+  EXPECT_EQ(from_bfloat16(to_bfloat16(1.f + 0x1p-8f)), 1.f);
+  EXPECT_EQ(from_bfloat16(to_bfloat16(1.f + 3 * 0x1p-8f)), 1.f + 0x1p-6f);
+  EXPECT_EQ(from_bfloat16(to_bfloat16(1.f + 0x1p-8f + 0x1p-20f)), 1.f + 0x1p-7f);
+  EXPECT_EQ(from_bfloat16(to_bfloat16(-2.5f)), -2.5f);
+  const float inf = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(from_bfloat16(to_bfloat16(inf)), inf);
+  EXPECT_EQ(from_bfloat16(to_bfloat16(-inf)), -inf);
+  EXPECT_TRUE(std::isnan(from_bfloat16(to_bfloat16(std::numeric_limits<float>::quiet_NaN()))));
+  EXPECT_EQ(from_bfloat16(to_bfloat16(std::numeric_limits<float>::max())), inf);
+  Pcg32 rng(3, 4);
+  for (int i = 0; i < 100000; ++i) {
+    const float v = std::ldexp(rng.next_float() + 0.5f, int(rng.next_float() * 200) - 100);
+    const float r = from_bfloat16(to_bfloat16(v));
+    ASSERT_LE(std::abs(r - v), 0x1p-8f * std::abs(v)) << v;
+  }
+}

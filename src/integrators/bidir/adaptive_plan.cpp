@@ -9,6 +9,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "core/bfloat16.h"
 #include "core/math.h"
 
 namespace caustica::bidir {
@@ -175,7 +176,7 @@ IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
 }
 
 void AdaptivePlan::begin_probe(float radius) {
-  light_sums_.assign(pixels_ * kCandidates, 0.f);
+  light_sums_.assign(pixels_ * kCandidates, to_bfloat16(0.f));
   const std::vector<Candidate>& list = candidates();
   for (size_t j = 0; j < kCandidates; ++j) {
     const MisCounts n = counts_of(list[j], pixels_, radius);
@@ -231,14 +232,16 @@ void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTer
                                    const MisCounts& counts) {
   CandidateSums sums = pixel_start(pixel);
   add(sums, value, terms, counts);
-  std::copy(sums.r.begin(), sums.r.end(), light_sums_.begin() + pixel * kCandidates);
+  uint16_t* stored = &light_sums_[pixel * kCandidates];
+  for (size_t j = 0; j < kCandidates; ++j) stored[j] = to_bfloat16(sums.r[j]);
   float* m = &moments_[pixel * kCandidates];
   for (size_t j = 0; j < kCandidates; ++j) m[j] += sums.d[j];
 }
 
 AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
   CandidateSums sums;
-  std::copy_n(light_sums_.begin() + pixel * kCandidates, kCandidates, sums.r.begin());
+  const uint16_t* stored = &light_sums_[pixel * kCandidates];
+  for (size_t j = 0; j < kCandidates; ++j) sums.r[j] = from_bfloat16(stored[j]);
   return sums;
 }
 
@@ -263,9 +266,9 @@ void add_counts(ProbeWork& total, const ProbeWork& w) {
 
 void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means) {
   ++probes_;
-  // The light-tracing sums (4 bytes per pixel and candidate) are only needed while a probe
+  // The light-tracing sums (2 bytes per pixel and candidate) are only needed while a probe
   // renders; released before the choice, so that its buffers do not add to them.
-  std::vector<float>().swap(light_sums_);
+  std::vector<uint16_t>().swap(light_sums_);
   add_counts(work_, w);
   work_.light_seconds += w.light_seconds;
   work_.camera_seconds += w.camera_seconds;

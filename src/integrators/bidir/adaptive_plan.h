@@ -144,8 +144,12 @@ class AdaptivePlan {
   int width_ = 0, height_ = 0;
   bool measured_ = false;
   bool probe_all_ = false;
-  std::vector<float> moments_;     // pixels x candidates: sum over probes of A^2 + D
-  std::vector<float> light_sums_;  // pixels x candidates: this probe's light-tracing R
+  std::vector<float> moments_;  // pixels x candidates: sum over probes of A^2 + D
+  // pixels x candidates: this probe's light-tracing R, in bfloat16 while the probe renders. A
+  // pixel gets a few splats per probe, so the sum keeps 2^-8 relative precision, far below the
+  // sampling noise of one probe's second-moment estimate. (The moments are float: they add up
+  // every probe, and a 16-bit sum stops growing once an increment falls below its rounding.)
+  std::vector<uint16_t> light_sums_;
   // The candidates' counts per class for this probe's radius (structure of arrays).
   struct CountTable {
     std::array<float, kCandidates> emitter{}, light_trace{}, connect{}, merge{};

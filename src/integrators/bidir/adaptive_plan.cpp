@@ -9,7 +9,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "core/bfloat16.h"
+#include "core/compact_float.h"
 #include "core/math.h"
 
 namespace caustica::bidir {
@@ -151,7 +151,7 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
       height_(height),
       measured_(measured_costs),
       probe_all_(probe_every_iteration),
-      moments_(pixels_ * kCandidates, 0.f),
+      moments_(pixels_ * kCandidates * 3, 0),  // float24 zeros
       merge_mask_(pixels_, 1) {
   chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
 }
@@ -234,8 +234,9 @@ void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTer
   add(sums, value, terms, counts);
   uint16_t* stored = &light_sums_[pixel * kCandidates];
   for (size_t j = 0; j < kCandidates; ++j) stored[j] = to_bfloat16(sums.r[j]);
-  float* m = &moments_[pixel * kCandidates];
-  for (size_t j = 0; j < kCandidates; ++j) m[j] += sums.d[j];
+  uint8_t* m = &moments_[pixel * kCandidates * 3];
+  for (size_t j = 0; j < kCandidates; ++j)
+    put_float24(m + 3 * j, get_float24(m + 3 * j) + sums.d[j]);
 }
 
 AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
@@ -246,11 +247,12 @@ AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
 }
 
 void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums) {
-  float* m = &moments_[pixel * kCandidates];
+  uint8_t* m = &moments_[pixel * kCandidates * 3];
   for (size_t j = 0; j < kCandidates; ++j) {
     const float c = table_.connect[j], r = sums.r[j], s0 = sums.s0[j], s1 = sums.s1[j];
-    m[j] += r * r + 2 * r * (s0 + (c - 1) * s1) + s0 * s0 + (c - 1) * s1 * s1 +
-            c * (c - 1) * s0 * s1 + sums.d[j];
+    const float moment = r * r + 2 * r * (s0 + (c - 1) * s1) + s0 * s0 + (c - 1) * s1 * s1 +
+                         c * (c - 1) * s0 * s1 + sums.d[j];
+    put_float24(m + 3 * j, get_float24(m + 3 * j) + moment);
   }
 }
 
@@ -279,7 +281,8 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
 }
 
 double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means) const {
-  const double mean = means[p], moment = moments_[p * kCandidates + j] / double(probes_);
+  const double mean = means[p];
+  const double moment = get_float24(&moments_[(p * kCandidates + j) * 3]) / double(probes_);
   return std::max(moment - mean * mean, 0.0) / (mean * mean + kRelEps);
 }
 

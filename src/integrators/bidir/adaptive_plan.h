@@ -144,11 +144,15 @@ class AdaptivePlan {
   int width_ = 0, height_ = 0;
   bool measured_ = false;
   bool probe_all_ = false;
-  std::vector<float> moments_;  // pixels x candidates: sum over probes of A^2 + D
+  // pixels x candidates: the sum over probes of the second-moment estimates, as float24 (3 bytes
+  // each, core/compact_float.h). 2^-16 relative rounding per addition: thousands of additions
+  // (every probe, every light-tracing splat) stay far below the probes' sampling noise, and far
+  // from where a sum stops growing. Not bfloat16: 2^-8 would lose a pixel's variance in the
+  // rounding of its mean^2, and its sums would stall after a few hundred terms.
+  std::vector<uint8_t> moments_;
   // pixels x candidates: this probe's light-tracing R, in bfloat16 while the probe renders. A
   // pixel gets a few splats per probe, so the sum keeps 2^-8 relative precision, far below the
-  // sampling noise of one probe's second-moment estimate. (The moments are float: they add up
-  // every probe, and a 16-bit sum stops growing once an increment falls below its rounding.)
+  // sampling noise of one probe's second-moment estimate.
   std::vector<uint16_t> light_sums_;
   // The candidates' counts per class for this probe's radius (structure of arrays).
   struct CountTable {

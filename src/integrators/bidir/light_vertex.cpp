@@ -4,6 +4,8 @@
 #include <bit>
 #include <cmath>
 
+#include "core/compact_float.h"
+
 namespace caustica::bidir {
 
 namespace {
@@ -53,19 +55,6 @@ uint32_t snorm16(float v) {
 }
 float from_snorm16(uint32_t b) { return float(b) / 65535.f * 2.f - 1.f; }
 
-// A float to 24 bits: its top three bytes, rounded to nearest (infinities and NaNs kept).
-void put24(uint8_t* out, float v) {
-  uint32_t bits = std::bit_cast<uint32_t>(v);
-  if ((bits & 0x7f800000u) != 0x7f800000u) bits += 0x80u;
-  bits >>= 8;
-  out[0] = uint8_t(bits);
-  out[1] = uint8_t(bits >> 8);
-  out[2] = uint8_t(bits >> 16);
-}
-float get24(const uint8_t* in) {
-  return std::bit_cast<float>((uint32_t(in[0]) | uint32_t(in[1]) << 8 | uint32_t(in[2]) << 16)
-                              << 8);
-}
 }  // namespace
 
 uint32_t encode_octahedral(Vec3 w) {
@@ -100,10 +89,10 @@ LightVertex pack_light_vertex(const LightVertexData& v) {
   out.position[2] = v.p.z;
   out.primitive = v.primitive;
   out.wo = encode_octahedral(v.wo);
-  put24(out.mis, v.mis.vcm);
-  put24(out.mis + 3, v.mis.rest);
-  put24(out.mis + 6, v.mis.conn);
-  put24(out.mis + 9, v.mis.merge);
+  put_float24(out.mis, v.mis.vcm);
+  put_float24(out.mis + 3, v.mis.rest);
+  put_float24(out.mis + 6, v.mis.conn);
+  put_float24(out.mis + 9, v.mis.merge);
   out.depth_and_throughput = uint64_t(std::clamp(v.depth, 0, 255)) | encode_throughput(v.throughput)
                                                                          << 8;
   return out;
@@ -115,7 +104,8 @@ LightVertexData unpack_light_vertex(const LightVertex& v) {
   d.wo = decode_octahedral(v.wo);
   d.primitive = v.primitive;
   d.depth = light_vertex_depth(v);
-  d.mis = {get24(v.mis), get24(v.mis + 3), get24(v.mis + 6), get24(v.mis + 9), d.depth == 1};
+  d.mis = {get_float24(v.mis), get_float24(v.mis + 3), get_float24(v.mis + 6),
+           get_float24(v.mis + 9), d.depth == 1};
   d.throughput = decode_throughput(v.depth_and_throughput >> 8);
   return d;
 }

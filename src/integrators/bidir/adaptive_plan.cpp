@@ -200,31 +200,30 @@ void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* t
   if (!(q > 0) || !std::isfinite(q) || !(own > 0)) return;
   const std::array<float, kCandidates>& own_count = table_.of(terms->own);
   const float f2 = value * value, inv_own = 1.f / own;
+  const float emitter = terms->emitter, light_trace = terms->light_trace, connect = terms->connect,
+              merge = terms->merge;
+  std::array<float, kCandidates>& sum = share == Share::None           ? sums.r
+                                        : share == Share::OwnLightPath ? sums.s0
+                                                                       : sums.s1;
+  // Every operation runs for every candidate and only constants are selected, so that the loop
+  // vectorises: a conditional division or product might raise a floating-point exception,
+  // which keeps the compiler from it. A candidate none of whose techniques makes this path
+  // (Q' = 0) would miss the energy: ratio 0, and D becomes infinite.
   for (size_t j = 0; j < kCandidates; ++j) {
-    const float q_candidate = own_count[j] + terms->emitter +
-                              table_.light_trace[j] * terms->light_trace +
-                              table_.connect[j] * terms->connect + table_.merge[j] * terms->merge;
-    // No technique of the candidate makes this path: it would miss the energy.
-    if (!(q_candidate > 0)) {
-      sums.d[j] = std::numeric_limits<float>::infinity();
-      continue;
-    }
-    const float ratio = q / q_candidate;
-    sums.d[j] += f2 * ratio;
-    if (share == Share::None) {
-      const float g = value * ratio * (own_count[j] * inv_own);
-      sums.r[j] += g;
-      sums.d[j] -= g * g;
-    } else if (own_count[j] > 0) {  // one of the candidate's connections (if it makes any)
-      const float g = value * ratio;
-      if (share == Share::OwnLightPath) {
-        sums.s0[j] += g;
-        sums.d[j] -= g * g;
-      } else {
-        sums.s1[j] += g;
-        sums.d[j] -= (own_count[j] - 1) * g * g;
-      }
-    }
+    const float q_candidate = own_count[j] + emitter + table_.light_trace[j] * light_trace +
+                              table_.connect[j] * connect + table_.merge[j] * merge;
+    const bool made = q_candidate > 0;
+    const float ratio = q / (made ? q_candidate : q) * (made ? 1.f : 0.f);
+    // The contribution under the candidate: a connection counts once per connection the
+    // candidate makes (none if it makes none); other techniques scale with their sample count.
+    const float scale = share == Share::None ? own_count[j] * inv_own : std::min(own_count[j], 1.f);
+    const float g = value * ratio * scale;
+    // How often g^2 enters the moment (pixel_end): a random light path's connection c' - 1
+    // times.
+    const float squares = share == Share::RandomLightPath ? own_count[j] - 1 : 1.f;
+    sum[j] += g;
+    sums.d[j] = (sums.d[j] + f2 * ratio - squares * g * g) +
+                (made ? 0.f : std::numeric_limits<float>::infinity());
   }
 }
 

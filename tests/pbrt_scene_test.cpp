@@ -281,8 +281,8 @@ TEST(PbrtSharedScenes, CornellCausticsLoadsAndProjectsLikePbrtV4) {
 }
 
 TEST(PbrtSharedScenes, EveryOwnSceneLoads) {
-  for (const char* name :
-       {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic", "mis-plates"}) {
+  for (const char* name : {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic",
+                           "mis-plates", "sun-glass"}) {
     SCOPED_TRACE(name);
     test::captured_warnings().clear();
     std::unique_ptr<Scene> scene;
@@ -325,8 +325,8 @@ TEST(PbrtSharedScenes, EveryThirdPartySceneLoads) {
 // One sample per pixel with pt and a short path: every own scene renders to a finite,
 // lit image (the loader produced something an integrator can use).
 TEST(PbrtSharedScenes, OwnScenesRenderWithPt) {
-  for (const char* name :
-       {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic", "mis-plates"}) {
+  for (const char* name : {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic",
+                           "mis-plates", "sun-glass"}) {
     SCOPED_TRACE(name);
     auto scene = load_pbrt(shared(std::string(name) + ".pbrt"), test::capture_warning);
     IntegratorSettings settings;

@@ -7,8 +7,10 @@
 #include <nlohmann/json.hpp>
 
 #include "film/film.h"
+#include "integrators/bidir/adaptive_plan.h"
 #include "integrators/registry.h"
 #include "io/builtin_scenes.h"
+#include "io/scene_loader.h"
 #include "test_scenes.h"
 
 using namespace caustica;
@@ -137,12 +139,46 @@ TEST(AdaptiveVcm, KeepsMergingForCausticsAndReportsWhy) {
   const auto& mask = a["merge_mask"];
   EXPECT_EQ(mask["width"].get<int>() * mask["block"].get<int>(), 48);
   EXPECT_EQ(mask["fraction"].size(), size_t(mask["width"].get<int>() * mask["height"].get<int>()));
-  // The candidate table prices path tracing far worse than what was chosen.
+  // The candidate table prices path tracing far worse than what was chosen: it misses the
+  // energy of paths it cannot make in more pixels, or scores at least twice as high.
   const auto& table = a["history"].back()["candidates"];
   EXPECT_EQ(table[0]["light_path_factor"].get<double>(), 0.0);
-  double best = 1e300;
-  for (const auto& c : table) best = std::min(best, c["score"].get<double>());
-  EXPECT_GT(table[0]["score"].get<double>(), 2 * best);
+  double fewest_missing = 1e300, best = 1e300;
+  for (const auto& c : table) {
+    const double missing = c["pixels_missing_energy"].get<double>();
+    if (missing < fewest_missing) fewest_missing = missing, best = 1e300;
+    if (missing == fewest_missing && c["score"].is_number())
+      best = std::min(best, c["score"].get<double>());
+  }
+  const double pt_missing = table[0]["pixels_missing_energy"].get<double>();
+  EXPECT_TRUE(pt_missing > fewest_missing || table[0]["score"].get<double>() > 2 * best);
+}
+
+// sun-glass: the sun's caustic under a glass ball is made only by light paths (a delta light
+// seen through a specular surface); the rest is path tracing's easy case. adaptive-vcm keeps
+// light paths and merges at the caustic, and lets most pixels path trace alone (pt's estimator,
+// no light-tracing splats) instead of making every pixel pay for the bidirectional core. Before,
+// one pixel whose variance was infinite for every candidate without merging (the caustic seen
+// through the ball) made every score NaN (inf - inf in the 7 x 7 pooling), and the choice fell
+// back to path tracing, which misses the caustic: the image converged to the wrong value.
+TEST(AdaptiveVcm, KeepsLightPathsForACausticOnlyTheyMakeAndPathTracesElsewhere) {
+  auto scene = load_scene(std::string(CAUSTICA_SCENES) + "/sun-glass.pbrt");
+  // The sun's light paths start on a disk as wide as the 100 x 100 ground: one in about 5000
+  // reaches the ball, so the probes need the file's 160 x 120 light paths to see the caustic.
+  IntegratorSettings s;
+  s.max_depth = 8;
+  const nlohmann::json stats = adaptive_stats(*scene, s, 32);
+  const auto& a = stats["adaptive"];
+  ASSERT_EQ(a["history"].size(), 5u);  // after probes 2 to 6 (iterations 1, 3, 7, 15, 31)
+  for (const auto& h : a["history"]) {
+    SCOPED_TRACE(h["after_probe"].get<int>());
+    EXPECT_GT(h["light_path_factor"].get<double>(), 0.0);
+    EXPECT_GT(h["path_trace_fraction"].get<double>(), 0.5);
+    EXPECT_GT(h["merge_fraction"].get<double>(), 0.0);
+    const auto& pt = h["candidates"][0];
+    EXPECT_GT(pt["pixels_missing_energy"].get<double>(), 0.0);
+  }
+  EXPECT_TRUE(a.contains("path_trace_mask"));
 }
 
 // On the diffuse Cornell box path tracing wins: every iteration that is not a probe is rendered
@@ -161,4 +197,48 @@ TEST(AdaptiveVcm, PathTracingIterationsRunPathTracersEstimator) {
   EXPECT_LT(costs["path_tracing_vertex"].get<double>(), costs["camera_vertex"].get<double>());
   // The core's work is averaged over the iterations it rendered (the probes) only.
   EXPECT_GT(stats["bidir"]["work_per_iteration"]["light_paths"].get<double>(), 1000.0);
+}
+
+// The plan alone, fed by hand: every pixel of a 16 x 16 image gets a sample every candidate
+// makes alike (next event estimation), and pixel (8, 8) one that only merging makes. Path
+// tracing and every candidate without merging would miss that energy: infinite variance there,
+// which the 7 x 7 pooling spreads to the pixel's neighbours. The plan must keep light paths and
+// merge there, and may path trace everywhere else. It used to choose path tracing: the pooling's
+// running sum took inf - inf, every score became NaN, and the choice kept its default.
+TEST(AdaptiveVcm, AnInfiniteVarianceIsCountedNotAveragedAway) {
+  const int w = 16, h = 16;
+  bidir::AdaptivePlan plan(w, h, /*measured_costs=*/false);
+  bidir::MisCounts counts;  // a probe's: one light path per pixel, two connections, merging
+  counts.light_trace = float(w * h);
+  counts.connect = 2;
+  counts.merge = float(w * h) * 3.14159f * 0.01f * 0.01f;
+  bidir::TechniqueTerms shared;  // next event estimation, which every candidate makes alike
+  shared.own = bidir::TechniqueClass::Emitter;
+  bidir::TechniqueTerms merge_only;
+  merge_only.own = bidir::TechniqueClass::Merge;
+  for (int probe = 0; probe < 2; ++probe) {
+    plan.begin_probe(0.01f);
+    for (size_t p = 0; p < size_t(w * h); ++p) {
+      bidir::AdaptivePlan::CandidateSums sums = plan.pixel_start(p);
+      plan.add(sums, 1.f, &shared, counts);
+      if (p == size_t(8 * w + 8)) plan.add(sums, 1.f, &merge_only, counts);
+      plan.pixel_end(p, sums);
+    }
+    bidir::ProbeWork work;
+    work.light_paths = w * h;
+    work.light_vertices = work.camera_vertices = work.nondelta_camera_vertices = 2.0 * w * h;
+    work.connections = 4.0 * w * h;
+    work.merge_queries = 2.0 * w * h;
+    work.photons = 4.0 * w * h;
+    plan.finish_probe(work, std::vector<float>(size_t(w * h), 1.f));
+  }
+  const bidir::IterationPlan chosen = plan.plan(2);
+  EXPECT_GT(chosen.light_paths, 0u);
+  EXPECT_TRUE(chosen.merges(8 * w + 8));
+  EXPECT_FALSE(chosen.path_traces(8 * w + 8));
+  EXPECT_TRUE(chosen.path_traces(0));  // far from it, path tracing alone is as good and cheaper
+  nlohmann::json stats;
+  plan.report(stats);
+  const auto& pt = stats["adaptive"]["history"].back()["candidates"][0];
+  EXPECT_EQ(pt["pixels_missing_energy"].get<double>(), 49.0);  // the 7 x 7 pooling window
 }

@@ -78,16 +78,28 @@ CostModel costs_of(const ProbeWork& w, bool measured) {
 // rests on a handful of probe samples; choosing per pixel between two such estimates picks the
 // luckier one (a caustic pixel whose probes missed the caustic stops merging). Neighbours share
 // their light transport, so their estimates are pooled.
+// An infinite variance (a path the candidate cannot make) makes every pixel whose window holds
+// it infinite; it is counted, not summed: inf - inf in the running sum made the rest of the row
+// NaN, and a NaN in every candidate's sum left the choice to its default, path tracing, which
+// cannot make the path either (sun-glass: the sun's caustic seen through the glass ball).
 std::vector<double> box_blur(const std::vector<double>& in, int w, int h, int r) {
   std::vector<double> tmp(in.size()), out(in.size());
   auto pass = [r](const double* src, double* dst, int n, int stride) {
     double sum = 0;
-    int count = 0;
-    for (int i = 0; i < std::min(r, n); ++i) sum += src[size_t(i) * stride], ++count;
+    int count = 0, infinite = 0;
+    auto enter = [&](double v, int sign) {
+      if (std::isfinite(v))
+        sum += sign * v;
+      else
+        infinite += sign;  // NaN counts as infinite
+      count += sign;
+    };
+    for (int i = 0; i < std::min(r, n); ++i) enter(src[size_t(i) * stride], 1);
     for (int i = 0; i < n; ++i) {
-      if (i + r < n) sum += src[size_t(i + r) * stride], ++count;
-      if (i - r - 1 >= 0) sum -= src[size_t(i - r - 1) * stride], --count;
-      dst[size_t(i) * stride] = sum / count;
+      if (i + r < n) enter(src[size_t(i + r) * stride], 1);
+      if (i - r - 1 >= 0) enter(src[size_t(i - r - 1) * stride], -1);
+      dst[size_t(i) * stride] =
+          infinite > 0 ? std::numeric_limits<double>::infinity() : sum / count;
     }
   };
   // Rows, then columns, each independent of the others: in parallel, the same sums.
@@ -112,16 +124,33 @@ struct PixelWork {
   double camera_vertices, connections, light_vertices_per_path, merge_queries, photons;
 };
 
+// A pixel's share of the light paths' cost.
+double light_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
+  return c.light_path_factor * w.light_vertices_per_path * t.light_vertex;
+}
+
+// A pixel that path traces: pt's camera vertices, and its share of the light paths (which the
+// other pixels use).
+double path_tracing_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
+  return w.camera_vertices * t.path_tracing_vertex + light_cost(c, w, t);
+}
+
+// A pixel that runs the bidirectional core (without merging).
 double base_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
-  if (c.light_path_factor == 0) return w.camera_vertices * t.path_tracing_vertex;
-  return w.camera_vertices * t.camera_vertex +
-         c.light_path_factor * w.light_vertices_per_path * t.light_vertex +
+  if (c.light_path_factor == 0) return path_tracing_cost(c, w, t);
+  return w.camera_vertices * t.camera_vertex + light_cost(c, w, t) +
          c.connections * w.connections * t.connection;
 }
 
 // Photon density grows with the light paths: photons per query scale with the factor.
 double merge_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
   return w.merge_queries * t.merge_query + w.photons * c.light_path_factor * t.photon;
+}
+
+double fraction_of(const std::vector<PixelMode>& modes, PixelMode mode) {
+  return modes.empty()
+             ? 0.0
+             : double(std::count(modes.begin(), modes.end(), mode)) / double(modes.size());
 }
 
 MisCounts counts_of(const AdaptivePlan::Candidate& c, size_t pixels, float radius) {
@@ -152,7 +181,7 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
       measured_(measured_costs),
       probe_all_(probe_every_iteration),
       moments_(pixels_ * kCandidates * 3, 0),  // float24 zeros
-      merge_mask_(pixels_, 1) {
+      modes_(pixels_, PixelMode::Merge) {
   chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
 }
 
@@ -171,7 +200,7 @@ IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
     return p;
   }
   IterationPlan p = chosen_;
-  p.merge_mask = &merge_mask_;
+  p.modes = &modes_;
   return p;
 }
 
@@ -304,7 +333,7 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
   const size_t q = std::min(pixels_ - 1, size_t(double(pixels_) * kWinsorize));
   std::nth_element(sorted.begin(), sorted.begin() + q, sorted.end());
   const double cap = sorted[q];
-  for (double& x : shared) x = x > cap ? cap - x : 0.0;
+  for (double& x : shared) x = std::isfinite(x) && x > cap ? cap - x : 0.0;
   return shared;
 }
 
@@ -328,79 +357,108 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   const CostModel t = costs_of(work_, measured_);
   const std::vector<double> correction = shared_firefly_correction(means);
   const std::vector<double> pt = relative_variances(0, means, correction);
-  double best = std::numeric_limits<double>::infinity();
-  double path_tracing = std::numeric_limits<double>::infinity();
+  // Candidates compare by the pixels where their variance is infinite (energy they would miss:
+  // paths none of their techniques there can make), then by score. Path tracing is the
+  // default only among equals.
+  struct Score {
+    double missing = std::numeric_limits<double>::infinity();
+    double value = std::numeric_limits<double>::infinity();
+    bool operator<(const Score& o) const {
+      return missing != o.missing ? missing < o.missing : value < o.value;
+    }
+  };
+  Score best, path_tracing;
   size_t best_j = 0;
-  std::vector<uint8_t> mask(pixels_), best_mask(pixels_, 0);
+  std::vector<PixelMode> modes(pixels_), best_modes(pixels_, PixelMode::PathTrace);
   nlohmann::json table = nlohmann::json::array();
   // Candidates come in (no merge, merge) pairs after path tracing at index 0.
   for (size_t j = 0; j < k; j += (j == 0 ? 1 : 2)) {
     const Candidate& c = list[j];
     const double cost = base_cost(c, pw, t);
     const double extra = j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t);
+    const double traced = path_tracing_cost(c, pw, t);
     const std::vector<double> no_merge = j == 0 ? pt : relative_variances(j, means, correction);
     const std::vector<double> merge = j == 0 ? pt : relative_variances(j + 1, means, correction);
-    // Per block of pixels: variance, cost, variance without and with merging everywhere.
-    std::vector<std::array<double, 4>> blocks((pixels_ + kPixelBlock - 1) / kPixelBlock);
+    // Per pixel, the option of lowest variance x cost: path tracing alone (where it is as good
+    // as the light paths' techniques, it is cheaper: a caustic that only light paths make need
+    // not make every pixel pay for the bidirectional core), the core, or the core and merging.
+    // Per block of pixels: finite variance, cost, variance without and with merging
+    // everywhere, pixels of infinite variance.
+    std::vector<std::array<double, 5>> blocks((pixels_ + kPixelBlock - 1) / kPixelBlock);
     for_pixel_blocks(pixels_, [&](size_t b, size_t begin, size_t end) {
-      std::array<double, 4> sum{};
+      std::array<double, 5> sum{};
       for (size_t p = begin; p < end; ++p) {
-        const double v0 = no_merge[p], v1 = merge[p];
+        const double v0 = no_merge[p], v1 = merge[p], vt = pt[p];
         sum[2] += v0;
         sum[3] += v1;
-        mask[p] = j != 0 && v1 * (cost + extra) < v0 * cost;
-        sum[0] += mask[p] ? v1 : v0;
-        sum[1] += mask[p] ? cost + extra : cost;
+        const double core = std::min(v0 * cost, v1 * (cost + extra));
+        if (j == 0 || (vt * traced <= core && std::isfinite(vt)))
+          modes[p] = PixelMode::PathTrace;
+        else
+          modes[p] = v1 * (cost + extra) < v0 * cost ? PixelMode::Merge : PixelMode::Bidirectional;
+        const double v = modes[p] == PixelMode::PathTrace ? vt
+                         : modes[p] == PixelMode::Merge   ? v1
+                                                          : v0;
+        if (std::isfinite(v))
+          sum[0] += v;
+        else
+          sum[4] += 1;
+        sum[1] += modes[p] == PixelMode::PathTrace ? traced
+                  : modes[p] == PixelMode::Merge   ? cost + extra
+                                                   : cost;
       }
       blocks[b] = sum;
     });
-    double variance = 0, total_cost = 0, variance0 = 0, variance1 = 0;
-    for (const std::array<double, 4>& sum : blocks) {
+    double variance = 0, total_cost = 0, variance0 = 0, variance1 = 0, missing = 0;
+    for (const std::array<double, 5>& sum : blocks) {
       variance += sum[0];
       total_cost += sum[1];
       variance0 += sum[2];
       variance1 += sum[3];
+      missing += sum[4];
     }
-    const double score = variance * total_cost;
+    const Score score{missing, variance * total_cost};
     table.push_back({{"light_path_factor", c.light_path_factor},
                      {"connections", c.connections},
-                     {"merge_fraction",
-                      j == 0 ? 0.0 : double(std::count(mask.begin(), mask.end(), 1)) / pixels},
+                     {"merge_fraction", fraction_of(modes, PixelMode::Merge)},
+                     {"path_trace_fraction", fraction_of(modes, PixelMode::PathTrace)},
                      {"relative_variance", variance / pixels},
                      {"relative_variance_no_merge", variance0 / pixels},
                      {"relative_variance_all_merge", variance1 / pixels},
                      {"cost_us_per_pixel", total_cost / pixels},
-                     {"score", score}});
+                     {"pixels_missing_energy", missing},
+                     {"score", score.value}});
     if (j == 0) path_tracing = score;
     if (score < best) {
       best = score;
       best_j = j;
-      best_mask = mask;
+      best_modes = modes;
     }
   }
-  if (best_j != 0 && path_tracing <= kPathTracingMargin * best) {
+  if (best_j != 0 && path_tracing.missing == best.missing &&
+      path_tracing.value <= kPathTracingMargin * best.value) {
     best_j = 0;
-    std::fill(best_mask.begin(), best_mask.end(), 0);
+    std::fill(best_modes.begin(), best_modes.end(), PixelMode::PathTrace);
   }
   const Candidate& c = list[best_j];
   chosen_ = {};
   chosen_.light_paths = uint64_t(std::llround(double(c.light_path_factor) * pixels));
   chosen_.connections = c.connections;
   chosen_.merge_everywhere = false;
-  merge_mask_ = best_mask;
-  history_.push_back(
-      {{"after_probe", probes_},
-       {"light_path_factor", c.light_path_factor},
-       {"connections", c.connections},
-       {"merge_fraction", double(std::count(best_mask.begin(), best_mask.end(), 1)) / pixels},
-       {"costs_us",
-        {{"camera_vertex", t.camera_vertex},
-         {"path_tracing_vertex", t.path_tracing_vertex},
-         {"light_vertex", t.light_vertex},
-         {"connection", t.connection},
-         {"merge_query", t.merge_query},
-         {"photon", t.photon}}},
-       {"candidates", table}});
+  modes_ = best_modes;
+  history_.push_back({{"after_probe", probes_},
+                      {"light_path_factor", c.light_path_factor},
+                      {"connections", c.connections},
+                      {"merge_fraction", fraction_of(modes_, PixelMode::Merge)},
+                      {"path_trace_fraction", fraction_of(modes_, PixelMode::PathTrace)},
+                      {"costs_us",
+                       {{"camera_vertex", t.camera_vertex},
+                        {"path_tracing_vertex", t.path_tracing_vertex},
+                        {"light_vertex", t.light_vertex},
+                        {"connection", t.connection},
+                        {"merge_query", t.merge_query},
+                        {"photon", t.photon}}},
+                      {"candidates", table}});
 }
 
 void AdaptivePlan::report(nlohmann::json& stats) const {
@@ -409,22 +467,25 @@ void AdaptivePlan::report(nlohmann::json& stats) const {
   a["costs"] = measured_ ? "measured" : "model";
   a["light_paths_per_iteration"] = chosen_.light_paths;
   a["connections"] = chosen_.connections;
-  a["merge_fraction"] =
-      pixels_ ? double(std::count(merge_mask_.begin(), merge_mask_.end(), 1)) / double(pixels_)
-              : 0.0;
+  a["merge_fraction"] = fraction_of(modes_, PixelMode::Merge);
+  a["path_trace_fraction"] = fraction_of(modes_, PixelMode::PathTrace);
   a["history"] = history_;
-  // The merge mask, block-averaged to at most 64 x 64 cells.
+  // The masks, block-averaged to at most 64 x 64 cells.
   const int block = std::max(1, (std::max(width_, height_) + 63) / 64);
   const int cw = (width_ + block - 1) / block, ch = (height_ + block - 1) / block;
-  std::vector<double> fraction(size_t(cw) * ch, 0.0), count(size_t(cw) * ch, 0.0);
-  for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) {
-      const size_t cell = size_t(y / block) * cw + size_t(x / block);
-      fraction[cell] += merge_mask_[size_t(y) * width_ + x];
-      count[cell] += 1;
-    }
-  for (size_t i = 0; i < fraction.size(); ++i) fraction[i] /= std::max(count[i], 1.0);
-  a["merge_mask"] = {{"width", cw}, {"height", ch}, {"block", block}, {"fraction", fraction}};
+  auto mask = [&](PixelMode mode) {
+    std::vector<double> fraction(size_t(cw) * ch, 0.0), count(size_t(cw) * ch, 0.0);
+    for (int y = 0; y < height_; ++y)
+      for (int x = 0; x < width_; ++x) {
+        const size_t cell = size_t(y / block) * cw + size_t(x / block);
+        fraction[cell] += modes_[size_t(y) * width_ + x] == mode;
+        count[cell] += 1;
+      }
+    for (size_t i = 0; i < fraction.size(); ++i) fraction[i] /= std::max(count[i], 1.0);
+    return nlohmann::json{{"width", cw}, {"height", ch}, {"block", block}, {"fraction", fraction}};
+  };
+  a["merge_mask"] = mask(PixelMode::Merge);
+  a["path_trace_mask"] = mask(PixelMode::PathTrace);
   stats["adaptive"] = a;
 }
 

@@ -37,6 +37,7 @@
 // every probe, normalised by the film of all ranks (Integrator::shared_iteration).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -46,15 +47,29 @@
 
 namespace caustica::bidir {
 
+// What a pixel does in an iteration that follows a choice (not a probe): the bidirectional
+// core's camera subpaths without or with merging, or path tracing alone (pt's estimator; no
+// light-tracing splat lands in the pixel, so its MIS weights are pt's).
+enum class PixelMode : uint8_t { Bidirectional = 0, Merge = 1, PathTrace = 2 };
+
 // What one iteration renders.
 struct IterationPlan {
   uint64_t light_paths = 0;  // 0: camera paths only (path tracing)
   int connections = 1;       // light paths each camera vertex connects to
   bool merge_everywhere = true;
-  const std::vector<uint8_t>* merge_mask = nullptr;  // per pixel, when !merge_everywhere
-  bool probe = false;                                // record contributions for the planner
+  const std::vector<PixelMode>* modes = nullptr;  // per pixel, when !merge_everywhere
+  bool probe = false;                             // record contributions for the planner
   bool merges(size_t pixel) const {
-    return light_paths > 0 && (merge_everywhere || (merge_mask && (*merge_mask)[pixel]));
+    return light_paths > 0 && (merge_everywhere || (modes && (*modes)[pixel] == PixelMode::Merge));
+  }
+  bool path_traces(size_t pixel) const {
+    return !probe && (light_paths == 0 ||
+                      (!merge_everywhere && modes && (*modes)[pixel] == PixelMode::PathTrace));
+  }
+  bool any_merge() const {
+    return light_paths > 0 &&
+           (merge_everywhere ||
+            (modes && std::find(modes->begin(), modes->end(), PixelMode::Merge) != modes->end()));
   }
 };
 
@@ -118,10 +133,10 @@ class AdaptivePlan {
   void finish_probe(const ProbeWork& work, const std::vector<float>& means);
 
   // "adaptive": the configuration, the history of choices (each with its candidate table and
-  // costs) and the merge mask as the fraction of merging pixels in blocks of at most 64 x 64
-  // cells ("merge_mask": width, height, row-major "fraction").
+  // costs), and the fractions of merging and of path-traced pixels in blocks of at most 64 x 64
+  // cells ("merge_mask" and "path_trace_mask": width, height, row-major "fraction").
   void report(nlohmann::json& stats) const;
-  const std::vector<uint8_t>& merge_mask() const { return merge_mask_; }
+  const std::vector<PixelMode>& modes() const { return modes_; }
 
   struct Candidate {
     float light_path_factor = 0;  // light paths / pixels
@@ -166,7 +181,7 @@ class AdaptivePlan {
   } table_;
   int probes_ = 0;
   ProbeWork work_;  // summed over probes
-  std::vector<uint8_t> merge_mask_;
+  std::vector<PixelMode> modes_;
   IterationPlan chosen_;
   std::vector<nlohmann::json> history_;
 };

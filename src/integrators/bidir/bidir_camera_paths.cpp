@@ -17,14 +17,17 @@ namespace caustica::bidir {
 
 Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng,
                               ScratchArena& arena, uint64_t* nonfinite) const {
-  if (path_tracer_ && current_.plan.light_paths == 0 && !current_.plan.probe)
-    return path_tracer_->radiance(scene, sample.ray, rng, arena);
+  const Iteration& it = current_;
+  // A path-traced pixel gets no light-tracing splat (connect_to_camera): pt's estimator alone.
+  const bool path_traces = tech_.adaptive && it.plan.path_traces(sample.pixel);
+  if (path_tracer_ && path_traces) return path_tracer_->radiance(scene, sample.ray, rng, arena);
   PixelAccumulator acc;
   acc.pixel = sample.pixel;
   acc.filter_weight = sample.filter_weight;
   if (techniques_.enabled()) acc.techniques = &techniques_;
-  const Iteration& it = current_;
-  acc.rules = it.plan.merges(sample.pixel) ? &it.rules : &it.rules_no_merge;
+  acc.rules = path_traces                    ? &it.rules_camera_only
+              : it.plan.merges(sample.pixel) ? &it.rules
+                                             : &it.rules_no_merge;
   if (it.plan.probe) {
     acc.plan = &plan_;
     acc.candidate_sums = plan_.pixel_start(sample.pixel);
@@ -194,7 +197,7 @@ void BidirIntegrator::connect_to_light_paths(const Scene& scene, const Iteration
                                              PixelAccumulator& acc) const {
   const uint64_t n = it.plan.light_paths;
   const int c = it.plan.connections;
-  if (n == 0 || c == 0) return;
+  if (n == 0 || c == 0 || rules.counts().connect == 0) return;
   const Rgb scaled = v.beta / float(c);
   for (int j = 0; j < c; ++j) {
     const uint64_t path =

@@ -76,7 +76,10 @@ struct Iteration {
   IterationPlan plan;  // light paths, connections, merging
   float radius = 0;
   MisRules rules{MisHeuristic::Balance, false, false, 1, 0};
-  MisRules rules_no_merge = rules;    // in pixels that do not merge (adaptive-vcm)
+  MisRules rules_no_merge = rules;  // in pixels that do not merge (adaptive-vcm)
+  // In pixels that path trace (adaptive-vcm, PixelMode::PathTrace) when pt's estimator is not
+  // at hand (technique images): emitter hits and next event estimation only.
+  MisRules rules_camera_only = rules;
   float merge_normalization = 0;      // 1 / (N pi r^2)
   LightPathAssignment light_path_of;  // pixel -> the light subpath it connects to
 };

@@ -113,6 +113,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   counts.merge = tech_.merge ? kPi * it.radius * it.radius * float(n) : 0.f;
   it.rules = MisRules(heuristic_, counts);
   it.rules_no_merge = it.rules.with_merging(false);
+  it.rules_camera_only = MisRules(heuristic_, {counts.emitter, 0.f, 0.f, 0.f});
   it.merge_normalization = n ? 1.f / (kPi * it.radius * it.radius * float(n)) : 0.f;
   it.light_path_of =
       LightPathAssignment(film.pixel_count(), std::max<uint64_t>(n, 1), iteration, settings_.seed);
@@ -131,10 +132,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   size_chunks(n);
   trace_light_paths(scene, it, film);
   const double light_seconds = seconds_since(light_start);
-  const bool any_merge =
-      tech_.merge && n > 0 &&
-      (it.plan.merge_everywhere || std::find(it.plan.merge_mask->begin(), it.plan.merge_mask->end(),
-                                             1) != it.plan.merge_mask->end());
+  const bool any_merge = tech_.merge && it.plan.any_merge();
   if (any_merge) {
     const auto grid_start = std::chrono::steady_clock::now();
     grid_.build(vertices_, it.radius);

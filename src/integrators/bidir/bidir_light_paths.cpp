@@ -215,6 +215,7 @@ void BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
   filter_.for_each_pixel(
       cs->raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
         const uint32_t pixel = uint32_t(y * camera.width() + x);
+        if (tech_.adaptive && it.plan.path_traces(pixel)) return;  // pt's estimator alone there
         const MisRules& rules = it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
         const TechniqueTerms terms = terms_light_to_camera(rules, lens, mis, fs.pdf);
         const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());

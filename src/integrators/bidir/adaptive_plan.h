@@ -4,7 +4,8 @@
 //
 // A configuration is the number of light paths per iteration (0: path tracing with NEE and MIS,
 // up to 2x the pixel count), the number of light paths each camera vertex connects to
-// (0, 1, 2, 4, 8) and, per pixel, whether the camera vertices merge. Probe iterations render full
+// (0, 1, 2, 4, 8) and, per pixel, a mode (PixelMode: path trace alone, the core, the core and
+// merging). Probe iterations render full
 // VCM (one light path per pixel, two connections per camera vertex: the pixel's own light path
 // and one drawn at random, merging everywhere) and record every contribution F of every pixel
 // with its MIS terms. Under the balance heuristic the second
@@ -20,17 +21,20 @@
 // vertices, light vertices, connections, merge queries and photons) times per-operation costs,
 // either measured in the probes on this machine (non-deterministic, used with --time) or the
 // fixed model below (deterministic). The choice minimises sum_p relVar_p x cost: for each global
-// (light paths, connections) the merge mask takes, per pixel, the option of lower
-// variance x (pixel cost); then the global pair of lowest total wins.
+// (light paths, connections) each pixel takes the mode of lowest variance x (pixel cost), path
+// tracing only where its variance is within a margin of the core's; then the global pair wins
+// that misses energy (infinite variance: paths none of its techniques make) in the fewest pixels,
+// and among those has the lowest total.
 //
 // Probes are iterations 0, 1, 3, 7, 15, 31, ... (2^k - 1): their cost fades as the render
 // grows. The first choice is made after the second probe; the variance all candidates share
 // is winsorised at its 99.5th percentile over the pixels (a shared firefly must not decide) and
-// pooled over 7 x 7 neighbours before the per-pixel merge decision (a handful of samples per
-// pixel would otherwise decide by luck).
-// Iterations that choose path tracing (and are not probes) are rendered by pt's own estimator
+// pooled over 7 x 7 neighbours before the per-pixel decision (a handful of samples per pixel
+// would otherwise decide by luck; an infinite variance makes its whole window infinite).
+// Iterations and pixels that path trace (and are not probes) are rendered by pt's own estimator
 // (path_tracer.h, power heuristic unless --mis says otherwise), cheaper than the core's camera
-// subpaths; the cost model prices their camera vertices separately.
+// subpaths, and no light-tracing splat lands in such a pixel; the cost model prices their camera
+// vertices separately.
 // Every iteration, probe or not, is an unbiased (consistent, when merging) estimate of the
 // same image, and the film averages them. Deterministic at fixed spp and seed for any thread
 // count unless measured costs are asked for, and for any number of MPI ranks: every rank renders

@@ -243,10 +243,9 @@ void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* t
   std::array<float, kCandidates>& sum = share == Share::None           ? sums.r
                                         : share == Share::OwnLightPath ? sums.s0
                                                                        : sums.s1;
-  // Every operation runs for every candidate and only constants are selected, so that the loop
-  // vectorises: a conditional division or product might raise a floating-point exception,
-  // which keeps the compiler from it. A candidate none of whose techniques makes this path
-  // (Q' = 0) would miss the energy: ratio 0, and D becomes infinite.
+  // Written without branches, so that the loop vectorises (with -fno-trapping-math for this
+  // file: src/CMakeLists.txt). A candidate none of whose techniques makes this path (Q' = 0)
+  // would miss the energy: ratio 0, and D becomes infinite.
   for (size_t j = 0; j < kCandidates; ++j) {
     const float q_candidate = own_count[j] + emitter + table_.light_trace[j] * light_trace +
                               table_.connect[j] * connect + table_.merge[j] * merge;

@@ -29,8 +29,8 @@ std::vector<IntegratorInfo> make_registry() {
   r.push_back({"vcm", "vertex connection and merging: bpt and bpm under one MIS", false, true, true,
                MisHeuristic::Balance, bidir(BidirAlgorithm::Vcm)});
   r.push_back({"adaptive-vcm",
-               "vcm that picks its light paths, connections and per-pixel merging while "
-               "rendering (efficiency-aware MIS, Grittmann 2022)",
+               "vcm that picks its light paths, connections and, per pixel, path tracing or "
+               "merging while rendering (efficiency-aware MIS, Grittmann 2022)",
                false, true, true, MisHeuristic::Balance, bidir(BidirAlgorithm::AdaptiveVcm)});
   r.push_back({"guided-pt",
                "path tracing guided by incident radiance learned while rendering (Mueller 2017)",

@@ -399,23 +399,25 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
         const double v0 = no_merge[p], v1 = merge[p], vt = pt[p];
         sum[2] += v0;
         sum[3] += v1;
-        const double core = std::min(v0 * cost, v1 * (cost + extra));
-        const bool path_trace = vt * traced <= core && std::isfinite(vt) &&
-                                vt <= kPathTracingPixelMargin * std::min(v0, v1);
-        if (j == 0 || path_trace)
+        // The core, with merging where that is better; path tracing where it beats both.
+        double v = v0, pixel_cost = cost;
+        modes[p] = PixelMode::Bidirectional;
+        if (v1 * (cost + extra) < v0 * cost) {
+          v = v1;
+          pixel_cost = cost + extra;
+          modes[p] = PixelMode::Merge;
+        }
+        if (j == 0 || (vt * traced <= v * pixel_cost && std::isfinite(vt) &&
+                       vt <= kPathTracingPixelMargin * std::min(v0, v1))) {
+          v = vt;
+          pixel_cost = traced;
           modes[p] = PixelMode::PathTrace;
-        else
-          modes[p] = v1 * (cost + extra) < v0 * cost ? PixelMode::Merge : PixelMode::Bidirectional;
-        const double v = modes[p] == PixelMode::PathTrace ? vt
-                         : modes[p] == PixelMode::Merge   ? v1
-                                                          : v0;
+        }
         if (std::isfinite(v))
           sum[0] += v;
         else
           sum[4] += 1;
-        sum[1] += modes[p] == PixelMode::PathTrace ? traced
-                  : modes[p] == PixelMode::Merge   ? cost + extra
-                                                   : cost;
+        sum[1] += pixel_cost;
       }
       blocks[b] = sum;
     });

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "experiment/adaptive_view.h"
 #include "film/film.h"
 #include "integrators/bidir/adaptive_plan.h"
 #include "integrators/registry.h"
@@ -241,4 +242,37 @@ TEST(AdaptiveVcm, AnInfiniteVarianceIsCountedNotAveragedAway) {
   plan.report(stats);
   const auto& pt = stats["adaptive"]["history"].back()["candidates"][0];
   EXPECT_EQ(pt["pixels_missing_energy"].get<double>(), 49.0);  // the 7 x 7 pooling window
+}
+
+// The report's table shows the candidate the plan chose, not the one of lowest score: path
+// tracing can score lowest over the pixels it renders while missing energy in others (its
+// score is then not comparable), as on sun-glass.
+TEST(AdaptiveVcm, ReportShowsTheChosenCandidateNotTheLowestScore) {
+  nlohmann::json history = {{"after_probe", 2},
+                            {"light_path_factor", 0.5},
+                            {"connections", 1},
+                            {"merge_fraction", 0.01},
+                            {"path_trace_fraction", 0.7},
+                            {"candidates",
+                             {{{"light_path_factor", 0.0},
+                               {"connections", 0},
+                               {"score", 1.0},
+                               {"pixels_missing_energy", 150.0},
+                               {"relative_variance", 0.111},
+                               {"cost_us_per_pixel", 0.5}},
+                              {{"light_path_factor", 0.5},
+                               {"connections", 1},
+                               {"score", 2.0},
+                               {"pixels_missing_energy", 0.0},
+                               {"relative_variance", 0.222},
+                               {"cost_us_per_pixel", 0.9}}}}};
+  ComparisonResult result;
+  IntegratorRun run;
+  run.integrator = "adaptive-vcm";
+  run.integrator_stats["adaptive"]["history"] = nlohmann::json::array({history});
+  result.runs.push_back(run);
+  const std::string html = adaptive_choices_html(result);
+  EXPECT_NE(html.find("0.222"), std::string::npos) << html;
+  EXPECT_EQ(html.find("0.111"), std::string::npos) << html;
+  EXPECT_NE(html.find("70.0%"), std::string::npos) << html;  // the path-traced share
 }

@@ -44,10 +44,14 @@ std::string adaptive_choices_html(const ComparisonResult& result) {
       << "<th>cost (us / pixel)</th>"
       << "</tr></thead><tbody>\n";
     for (const auto& h : a["history"]) {
-      // The chosen row of the candidate table: the lowest score.
+      // The chosen row of the candidate table: the one of the chosen light paths and connections
+      // (not simply the lowest score: the plan first compares the pixels where a candidate would
+      // miss energy, and keeps path tracing within a margin).
       const nlohmann::json* best = nullptr;
       for (const auto& c : h["candidates"])
-        if (!best || number(c["score"]) < number((*best)["score"])) best = &c;
+        if (c["light_path_factor"] == h["light_path_factor"] &&
+            c["connections"] == h["connections"])
+          best = &c;
       o << "<tr><td>" << h["after_probe"].get<int>() << "</td><td>"
         << num(h["light_path_factor"].get<double>(), "%g") << "</td><td>"
         << h["connections"].get<int>() << "</td><td>"

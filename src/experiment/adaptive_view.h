@@ -1,7 +1,8 @@
 // The comparison report's view of what adaptive-vcm chose (integrators/bidir/adaptive_plan.h):
 // per adaptive run, the configuration after each probe (light paths per pixel, connections per
-// camera vertex, share of merging pixels, predicted relative variance and cost) and the final
-// per-pixel merge mask as an inline SVG (white: the pixel merges). Empty when no run has it.
+// camera vertex, shares of merging and of path-traced pixels, the chosen candidate's predicted
+// relative variance and cost) and the final per-pixel merge and path-trace masks as inline SVGs
+// (white: the pixel merges / path traces alone). Empty when no run has it.
 #pragma once
 
 #include <string>

@@ -286,7 +286,8 @@ std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene, bool guide_cam
     return scene.intersect(ray, si);
   };
   for (int pass = 0; pass < 3; ++pass) {
-    g->begin_iteration(uint32_t(pass == 0 ? 0 : 1u << pass), 0.0, no_variances);  // 0, 2, 4
+    const uint32_t first = pass == 0 ? 0 : 1u << pass;  // passes 0-1, 2-3, 4-7
+    g->begin_iteration(first, 0.0);
     std::vector<LightVertex> photons;
     for (int i = 0; i < 6000; ++i) {
       SurfaceInteraction si;
@@ -297,8 +298,9 @@ std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene, bool guide_cam
         g->record_camera_vertex(uint64_t(i), 1, si.p, si.ng, si.wo, Rgb(0.1f + u(gen)));
     }
     g->end_iteration(scene, photons);
+    // Ends the pass (as after its last iteration, 1, 3 or 7): what it learned is sampled next.
+    EXPECT_TRUE(g->end_pass_after(first == 0 ? 1 : 2 * first - 1, 0.0, no_variances));
   }
-  g->begin_iteration(8, 0.0, no_variances);  // ends the last pass: its fields are sampled
   return g;
 }
 

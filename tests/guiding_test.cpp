@@ -435,6 +435,40 @@ TEST(Guiding, InverseVarianceCombinationWeightsPasses) {
   EXPECT_NEAR(passes[2].variance, 4.0, 1e-9);
 }
 
+// The current pass split over two processes (each rendered some of its iterations) and summed
+// exactly gives one process's combination bit for bit (MPI ranks: sums_over_ranks). Values
+// chosen so that a double sum in another order rounds differently; a firefly far above the
+// fixed-point clamp of a single value (2^31) keeps its square in the variance.
+TEST(Guiding, InverseVarianceCurrentPassSumsOverProcessesExactly) {
+  const float samples[6][2] = {{0.1f, 3e4f},  {1e-3f, 0.7f}, {1e7f, 0.3f},
+                               {0.2f, 1e-5f}, {0.3f, 2.f},   {1e-7f, 5.f}};
+  InverseVarianceCombiner one(2, 1), a(2, 1), b(2, 1);
+  auto add = [](InverseVarianceCombiner& c, const float* v) {
+    c.add(0, Rgb(v[0]));
+    c.add(1, Rgb(v[1], v[0], 1.f));
+    c.end_iteration();
+  };
+  for (int i = 0; i < 6; ++i) {
+    add(one, samples[i]);
+    add(i % 2 ? b : a, samples[i]);
+  }
+  const std::span<FixedSum> sa = a.current_sums(), sb = b.current_sums();
+  ASSERT_EQ(sa.size(), 2 * InverseVarianceCombiner::kSumsPerPixel + 1);
+  for (size_t i = 0; i < sa.size(); ++i) sa[i] += sb[i];
+  const Image x = one.image(), y = a.image();
+  ASSERT_FALSE(x.empty());
+  for (size_t i = 0; i < x.pixel_count(); ++i) EXPECT_TRUE(x[i] == y[i]) << i;
+  ASSERT_EQ(a.passes().size(), 1u);
+  EXPECT_EQ(a.passes()[0].samples, 6u);
+  EXPECT_EQ(a.passes()[0].variance, one.passes()[0].variance);
+  // Pixel 0's variance of the mean is about (1e14 - 1e14 / 6) / 5 / 6 (the 1e7 sample), the
+  // pass's the mean over the two pixels: about half of it (a square clamped at 2^31: 1e-4 of it).
+  const double pixel0 = (1e14 - 1e14 / 6) / 5 / 6;
+  EXPECT_NEAR(one.passes()[0].variance, 0.5 * pixel0, 0.01 * pixel0);
+  a.clear_current();
+  EXPECT_TRUE(a.passes().empty());
+}
+
 // Without a budget, passes double forever: two unguided iterations, then iteration i >= 2 in
 // pass floor(log2(i)).
 TEST(TrainingSchedule, PassesDoubleInLength) {

@@ -1,5 +1,5 @@
 // The accumulation that makes a render split over MPI ranks bit-identical to one process
-// (film/fixed_sum.h, film.h) and the render loop's dealing of iterations (render/ranks.h),
+// (core/fixed_sum.h, film.h) and the render loop's dealing of iterations (render/ranks.h),
 // checked without MPI.
 #include "render/ranks.h"
 
@@ -7,7 +7,6 @@
 
 #include <barrier>
 #include <cstdlib>
-#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -121,6 +120,13 @@ class PretendRank final : public LoneRounds {
     ADD_FAILURE() << "a lone pretend rank cannot sum films with the others";
     return true;
   }
+  bool any_stops(bool) override {
+    ADD_FAILURE() << "a lone pretend rank cannot meet the others";
+    return true;
+  }
+  void sum_to_root(std::span<FixedSum>) override {
+    ADD_FAILURE() << "a lone pretend rank cannot sum with the others";
+  }
 
  private:
   Film* out_;
@@ -163,18 +169,29 @@ struct ThreadPair {
   std::barrier<> meet;
   const Film* films[2] = {nullptr, nullptr};
   bool stops[2] = {false, false};
-  Film total;  // the final films' sum
-  std::mutex total_mutex;
-  int sums = 0;  // shared sums made (rank 0 counts)
+  Film total;        // the final films' sum
+  int sums = 0;      // shared sums of films made (rank 0 counts)
+  int meetings = 0;  // meetings without films (any_stops; rank 0 counts)
+  std::span<FixedSum> own_sums[2];
 };
 
 class ThreadRank final : public LoneRounds {
  public:
   ThreadRank(int rank, ThreadPair* pair, int stop_at_sum = -1)
       : LoneRounds(rank, 2), pair_(pair), stop_at_sum_(stop_at_sum) {}
-  void sum_films(const Film& mine, Film*) override {
-    const std::lock_guard<std::mutex> lock(pair_->total_mutex);
-    pair_->total.add(mine);
+  // A reduction onto rank 0, whose sum is also kept as the pair's total.
+  void sum_films(const Film& mine, Film* root_total) override {
+    pair_->films[rank_] = &mine;
+    pair_->meet.arrive_and_wait();
+    if (rank_ == 0) {
+      for (Film* f : {root_total, &pair_->total}) {
+        f->set_counts(0, 0);
+        for (FixedSum& x : f->sums()) x = 0;
+        f->add(*pair_->films[0]);
+        f->add(*pair_->films[1]);
+      }
+    }
+    pair_->meet.arrive_and_wait();
   }
   bool all_sum_films(const Film& mine, Film* total, bool stop) override {
     pair_->films[rank_] = &mine;
@@ -190,11 +207,29 @@ class ThreadRank final : public LoneRounds {
     pair_->meet.arrive_and_wait();  // both have read before either renders on
     return any;
   }
+  bool any_stops(bool stop) override {
+    pair_->stops[rank_] = stop || meetings_ == stop_at_sum_;
+    ++meetings_;
+    pair_->meet.arrive_and_wait();
+    const bool any = pair_->stops[0] || pair_->stops[1];
+    if (rank_ == 0) ++pair_->meetings;
+    pair_->meet.arrive_and_wait();
+    return any;
+  }
+  void sum_to_root(std::span<FixedSum> sums) override {
+    pair_->own_sums[rank_] = sums;
+    pair_->meet.arrive_and_wait();
+    if (rank_ == 0) {
+      EXPECT_EQ(pair_->own_sums[1].size(), sums.size());
+      for (size_t i = 0; i < sums.size(); ++i) sums[i] += pair_->own_sums[1][i];
+    }
+    pair_->meet.arrive_and_wait();  // rank 1's sums stay until rank 0 has read them
+  }
 
  private:
   ThreadPair* pair_;
-  int stop_at_sum_;
-  int sums_ = 0;
+  int stop_at_sum_;  // also the meeting (any_stops) at which it asks to stop
+  int sums_ = 0, meetings_ = 0;
 };
 
 // Renders `spp` iterations of `name` on two thread ranks; the sum of their films.
@@ -202,7 +237,7 @@ struct PairResult {
   Image image;
   uint32_t iterations[2] = {0, 0};
   bool interrupted[2] = {false, false};
-  int sums = 0;
+  int sums = 0, meetings = 0;
 };
 PairResult render_on_thread_pair(const Scene& scene, const char* name,
                                  const IntegratorSettings& settings, int spp,
@@ -221,12 +256,13 @@ PairResult render_on_thread_pair(const Scene& scene, const char* name,
     const RenderResult r = render(scene, *integrator, budget, cb);
     result.iterations[rank] = r.local_iterations;
     result.interrupted[rank] = r.interrupted;
+    if (rank == 0) result.image = r.image;
   };
   std::thread other(run, 1);
   run(0);
   other.join();
-  result.image = pair.total.image();
   result.sums = pair.sums;
+  result.meetings = pair.meetings;
   return result;
 }
 
@@ -254,6 +290,38 @@ TEST(RanksRender, AdaptiveVcmOnTwoRanksGivesTheOneProcessImageBitForBit) {
   for (size_t i = 0; i < other.image.pixel_count(); ++i)
     if (!(other.image[i] == single.image[i])) ++differing;
   EXPECT_GT(differing, 0u);
+}
+
+// The guided integrators' training passes are shared: every rank renders them, so every rank
+// learns the same fields and decides the same schedule; only the final pass is split. guided-pt
+// weights its passes by their inverse variance, so rank 0 adds the ranks' sums of its final
+// pass (sums_over_ranks) and combines as one process does.
+TEST(RanksRender, GuidedIntegratorsOnTwoRanksGiveTheOneProcessImageBitForBit) {
+  auto scene = make_builtin_scene("cornell-glass", 24, 20);
+  for (const char* name : {"guided-pt", "guided-bpt", "guided-vcm"}) {
+    IntegratorSettings settings;
+    settings.seed = 7;
+    settings.guiding.spatial_threshold = 50;  // leaves split at this small resolution
+    // Training passes 0-1, 2-3, 4-7; then 8 more would leave less than 16: the final pass
+    // renders iterations 8-19.
+    const int spp = 20;
+    const RenderResult single = test::render_with(*scene, name, spp, settings);
+    const PairResult pair = render_on_thread_pair(*scene, name, settings, spp);
+    EXPECT_EQ(pair.iterations[0], 10u) << name;  // 0, 2, 4, 6, then 8, 10, ..., 18
+    EXPECT_EQ(pair.iterations[1], 10u) << name;
+    EXPECT_EQ(pair.meetings, 8) << name << ": one meeting before each training iteration";
+    EXPECT_EQ(pair.sums, 0) << name << ": the films are not summed before them";
+    size_t differing = 0;
+    for (size_t i = 0; i < pair.image.pixel_count(); ++i)
+      if (!(pair.image[i] == single.image[i])) ++differing;
+    EXPECT_EQ(differing, 0u) << name;
+    settings.seed = 8;  // a different seed changes the image, or the comparison proves nothing
+    const RenderResult other = test::render_with(*scene, name, spp, settings);
+    differing = 0;
+    for (size_t i = 0; i < other.image.pixel_count(); ++i)
+      if (!(other.image[i] == single.image[i])) ++differing;
+    EXPECT_GT(differing, 0u) << name;
+  }
 }
 
 // A stop asked for on one rank reaches the other at the next shared sums: both end there,

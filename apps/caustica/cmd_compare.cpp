@@ -60,7 +60,6 @@ int run_reference(const ReferenceOptions& o, const CheckedOptions& checks, Ranks
   const int prepared = prepare_on_all_ranks(ranks, [&] {
     if (!checks.check()) return 2;
     if (!check_name("integrator", o.integrator, integrator_names())) return 2;
-    if (int rc = refuse_learning_on_several_ranks(o.integrator, ranks)) return rc;
     const std::string out =
         o.outfile.empty() ? std::filesystem::path(o.scene).stem().string() + "-ref" : o.outfile;
     paths = output_paths_for(out);

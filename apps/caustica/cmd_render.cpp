@@ -90,7 +90,6 @@ int run_render(const RenderOptions& o, const CheckedOptions& checks, Ranks& rank
       for (const auto& n : integrator_names())
         if (n == scene->settings().integrator) integrator_name = n;
     }
-    if (int rc = refuse_learning_on_several_ranks(integrator_name, ranks)) return rc;
     integrator = make_integrator(integrator_name, settings);
     return 0;
   });
@@ -200,15 +199,6 @@ Runner add_render_command(CLI::App& app) {
                  "images and write the outputs, so that a killed run leaves one (default 60; 0: "
                  "only at the end)");
   return [opts, checks](Ranks& ranks) { return run_render(*opts, *checks, ranks); };
-}
-
-int refuse_learning_on_several_ranks(const std::string& integrator, const Ranks& ranks) {
-  const IntegratorInfo* info = find_integrator(integrator);
-  if (ranks.size() <= 1 || !info || !info->learns_while_rendering) return 0;
-  print_error(integrator +
-              " learns while it renders and its learned structures are not merged across MPI "
-              "ranks yet; run it with one rank");
-  return 2;
 }
 
 std::string integrator_help() {

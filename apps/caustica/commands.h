@@ -16,9 +16,6 @@ Runner add_render_command(CLI::App& app);
 Runner add_scenes_command(CLI::App& app);
 Runner add_integrators_command(CLI::App& app);
 
-// 2 (after printing why) if `integrator` learns while rendering and there are several ranks.
-int refuse_learning_on_several_ranks(const std::string& integrator, const Ranks& ranks);
-
 // One line per integrator of the registry: "name: description", for option help.
 std::string integrator_help();
 Runner add_reference_command(CLI::App& app);

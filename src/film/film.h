@@ -2,7 +2,7 @@
 // estimates: integrators apply the pixel filter by filter importance sampling and weighted splats
 // (pixel_filter.h).
 //
-// One buffer: every estimate is added exactly, in 64.64 fixed point (fixed_sum.h), to the
+// One buffer: every estimate is added exactly, in 64.64 fixed point (core/fixed_sum.h), to the
 // pixel's total as it arrives. Integer addition is associative, so the total depends only on the
 // set of estimates added, not on the order or grouping in which they are added: films rendered
 // by several processes and summed (add(), or an MPI reduction over sums()) equal, bit for bit,
@@ -24,8 +24,8 @@
 #include <span>
 #include <vector>
 
+#include "core/fixed_sum.h"
 #include "core/rgb.h"
-#include "film/fixed_sum.h"
 #include "image/image.h"
 
 namespace caustica {

@@ -7,6 +7,10 @@ namespace caustica {
 
 namespace {
 
+// The squared luminances are summed times 2^-32: fixed-point sums clamp a value at 2^31, and a
+// firefly's square is far above it (a luminance of 3e9 still fits; the resolution becomes 2^-32).
+constexpr int kSquareShift = 32;
+
 // A pass with zero variance is exact; its weight is huge but finite.
 double inverse(double variance) { return 1 / std::max(variance, 1e-300); }
 
@@ -15,58 +19,65 @@ double inverse(double variance) { return 1 / std::max(variance, 1e-300); }
 InverseVarianceCombiner::InverseVarianceCombiner(int width, int height)
     : width_(width),
       height_(height),
-      current_(size_t(width) * size_t(height)),
+      current_(size_t(width) * size_t(height) * kSumsPerPixel + 1, 0),
       combined_(size_t(width) * size_t(height), Rgb(0.f)) {}
 
 void InverseVarianceCombiner::add(size_t pixel, Rgb value) {
   if (!value.is_finite()) return;
-  Moments& m = current_[pixel];
-  m.r += value.r;
-  m.g += value.g;
-  m.b += value.b;
+  FixedSum* m = &current_[pixel * kSumsPerPixel];
+  m[0] += to_fixed(value.r);
+  m[1] += to_fixed(value.g);
+  m[2] += to_fixed(value.b);
   const double y = value.luminance();
-  m.luminance2 += y * y;
+  m[3] += to_fixed(std::ldexp(y * y, -kSquareShift));
+}
+
+Rgb InverseVarianceCombiner::mean(size_t i, double n) const {
+  const FixedSum* m = &current_[i * kSumsPerPixel];
+  return Rgb(float(from_fixed(m[0]) / n), float(from_fixed(m[1]) / n), float(from_fixed(m[2]) / n));
 }
 
 double InverseVarianceCombiner::current_variance() const {
-  if (samples_ < 2 || current_.empty()) return -1;
-  const double n = samples_;
+  const uint32_t samples = this->samples();
+  if (samples < 2) return -1;
+  const double n = samples;
+  const size_t pixels = size_t(width_) * size_t(height_);
   double sum = 0;
-  for (const Moments& m : current_) {
-    const double y = 0.2126 * m.r + 0.7152 * m.g + 0.0722 * m.b;
+  for (size_t i = 0; i < pixels; ++i) {
+    const FixedSum* m = &current_[i * kSumsPerPixel];
+    const double y =
+        0.2126 * from_fixed(m[0]) + 0.7152 * from_fixed(m[1]) + 0.0722 * from_fixed(m[2]);
     // Unbiased sample variance of the luminance, over n for the variance of the mean.
-    sum += std::max(0.0, m.luminance2 - y * y / n) / (n - 1) / n;
+    const double y2 = std::ldexp(from_fixed(m[3]), kSquareShift);
+    sum += std::max(0.0, y2 - y * y / n) / (n - 1) / n;
   }
-  return sum / double(current_.size());
+  return sum / double(pixels);
 }
 
 void InverseVarianceCombiner::end_pass() {
   const double v = current_variance();
-  completed_.push_back({samples_, v});
+  completed_.push_back({samples(), v});
   if (v >= 0) {
-    const double w = inverse(v), total = weight_ + w, n = samples_;
-    for (size_t i = 0; i < current_.size(); ++i) {
-      const Moments& m = current_[i];
-      const Rgb mean(float(m.r / n), float(m.g / n), float(m.b / n));
-      combined_[i] = combined_[i] * float(weight_ / total) + mean * float(w / total);
-    }
+    const double w = inverse(v), total = weight_ + w, n = samples();
+    for (size_t i = 0; i < combined_.size(); ++i)
+      combined_[i] = combined_[i] * float(weight_ / total) + mean(i, n) * float(w / total);
     weight_ = total;
   }
-  std::fill(current_.begin(), current_.end(), Moments{});
-  samples_ = 0;
+  clear_current();
+}
+
+void InverseVarianceCombiner::clear_current() {
+  std::fill(current_.begin(), current_.end(), FixedSum(0));
 }
 
 Image InverseVarianceCombiner::image() const {
   const double v = current_variance();
   if (v < 0 && weight_ == 0) return Image();
   Image out(width_, height_);
-  const double w = v < 0 ? 0 : inverse(v), total = weight_ + w, n = samples_;
+  const double w = v < 0 ? 0 : inverse(v), total = weight_ + w, n = samples();
   for (size_t i = 0; i < combined_.size(); ++i) {
     Rgb c = combined_[i] * float(weight_ / total);
-    if (w > 0) {
-      const Moments& m = current_[i];
-      c += Rgb(float(m.r / n), float(m.g / n), float(m.b / n)) * float(w / total);
-    }
+    if (w > 0) c += mean(i, n) * float(w / total);
     out[i] = c;
   }
   return out;
@@ -74,12 +85,12 @@ Image InverseVarianceCombiner::image() const {
 
 std::vector<InverseVarianceCombiner::Pass> InverseVarianceCombiner::passes() const {
   std::vector<Pass> all = completed_;
-  if (samples_ > 0) all.push_back({samples_, current_variance()});
+  if (samples() > 0) all.push_back({samples(), current_variance()});
   return all;
 }
 
 size_t InverseVarianceCombiner::bytes() const {
-  return current_.capacity() * sizeof(Moments) + combined_.capacity() * sizeof(Rgb);
+  return current_.capacity() * sizeof(FixedSum) + combined_.capacity() * sizeof(Rgb);
 }
 
 }  // namespace caustica

@@ -11,14 +11,19 @@
 // estimator), but consistent: the bias vanishes as the passes grow. Müller accepts this for the
 // much lower variance; the equal-weight average is the unbiased alternative.
 //
-// Determinism: add() has one writer per pixel at a time and sums in a fixed order; V_k is a
-// sequential sum over pixels. Memory: 44 bytes per pixel.
+// Determinism: the current pass's moments are exact fixed-point sums (core/fixed_sum.h), so they
+// depend only on which samples were added, not on their order or grouping: the current pass of
+// a render split over MPI ranks is summed over the ranks (current_sums()) and gives the
+// combination of one process bit for bit. add() has one writer per pixel at a time; V_k is a
+// sequential sum over pixels. Memory: 76 bytes per pixel (64 of them the current pass).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
+#include "core/fixed_sum.h"
 #include "core/rgb.h"
 #include "image/image.h"
 
@@ -32,7 +37,9 @@ class InverseVarianceCombiner {
   // One sample of a pixel (index y * width + x) in the current pass. Non-finite: ignored.
   void add(size_t pixel, Rgb value);
   // Every pixel received its sample of one more iteration of the current pass.
-  void end_iteration() { ++samples_; }
+  void end_iteration() {
+    if (!current_.empty()) current_.back() += 1;
+  }
   // Folds the current pass into the combination and starts the next one.
   void end_pass();
 
@@ -48,16 +55,24 @@ class InverseVarianceCombiner {
   std::vector<Pass> passes() const;
   size_t bytes() const;
 
+  // The current pass as exact sums (kSumsPerPixel per pixel, then its iteration count), for a
+  // sum over processes that each rendered some of its iterations: replaced by their total, they
+  // give the combination of one process that rendered them all. clear_current() empties it
+  // (a process whose current pass another one holds whole).
+  std::span<FixedSum> current_sums() { return current_; }
+  void clear_current();
+  static constexpr size_t kSumsPerPixel = 4;  // r, g, b, squared luminance
+
  private:
-  struct Moments {
-    double r = 0, g = 0, b = 0;  // sum of the samples
-    double luminance2 = 0;       // sum of their squared luminance
-  };
   double current_variance() const;  // V of the current pass; negative without an estimate
+  uint32_t samples() const { return current_.empty() ? 0 : uint32_t(current_.back()); }
+  // The current pass's mean of pixel i.
+  Rgb mean(size_t i, double n) const;
 
   int width_ = 0, height_ = 0;
-  std::vector<Moments> current_;
-  uint32_t samples_ = 0;       // iterations in the current pass
+  // Per pixel the sums of r, g, b and the squared luminance of its samples in the current pass;
+  // last, the pass's iterations (an integer, not scaled).
+  std::vector<FixedSum> current_;
   std::vector<Rgb> combined_;  // sum_k I_k / V_k / sum_k 1 / V_k over completed passes
   double weight_ = 0;          // sum_k 1 / V_k
   std::vector<Pass> completed_;

@@ -225,18 +225,11 @@ void GuidedPathTracer::prepare(const Scene& scene, Film& film) {
 }
 
 void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, Film& film) {
-  const double elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  if (schedule_.starts_pass(iteration, elapsed)) {
-    const bool learned = schedule_.ended_learning();
-    const int k = schedule_.ended_training_pass();
-    schedule_.end_pass(passes_.passes().back().variance);
-    if (learned) field_.end_pass(k);
-    passes_.end_pass();
-  }
+  if (iteration == 0) schedule_.starts_pass(0, seconds_since_start());
   if (!schedule_.learning()) {  // rendering: sampling only
     trace_camera_paths(scene, iteration, film);
     passes_.end_iteration();
+    end_pass_after(iteration);
     return;
   }
   // Slot pixel / stride: the recorded pixels are stride apart.
@@ -256,6 +249,27 @@ void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, 
   // buffers stay near kMaxRecords at any resolution (deterministic: counts, not threads).
   const uint64_t per_all_pixels = uint64_t(recorded) * record_stride_;
   record_stride_ = std::max<uint64_t>(1, (per_all_pixels + kMaxRecords - 1) / kMaxRecords);
+  end_pass_after(iteration);
+}
+
+double GuidedPathTracer::seconds_since_start() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+void GuidedPathTracer::end_pass_after(uint32_t iteration) {
+  if (!schedule_.starts_pass(iteration + 1, seconds_since_start())) return;
+  const bool learned = schedule_.ended_learning();
+  const int k = schedule_.ended_training_pass();
+  schedule_.end_pass(passes_.passes().back().variance);
+  if (learned) field_.end_pass(k);
+  passes_.end_pass();
+}
+
+std::span<FixedSum> GuidedPathTracer::sums_over_ranks(bool root) {
+  if (!settings_.guiding.inverse_variance) return {};  // the image is the film's
+  // Every rank rendered the whole of a pass that teaches (shared_iteration): rank 0's is it.
+  if (!root && !schedule_.final_pass()) passes_.clear_current();
+  return passes_.current_sums();
 }
 
 void GuidedPathTracer::finish(const Scene& scene, Film& film) {

@@ -79,6 +79,12 @@ class GuidedPathTracer final : public CameraPathIntegrator {
   Image image(const Film& film) const override;
   void finish(const Scene& scene, Film& film) override;
   void report(nlohmann::json& stats) const override;
+  // Training and trial passes teach: every MPI rank renders them (at a fixed --spp every rank
+  // then learns the same field and takes the same decisions). Only the final pass is split.
+  bool shared_iteration(uint32_t) const override { return !schedule_.final_pass(); }
+  // The final pass's pixel moments are summed over the ranks, so that rank 0 combines the passes
+  // as one process does.
+  std::span<FixedSum> sums_over_ranks(bool root) override;
 
   const GuidingField& field() const { return field_; }
   const TrainingSchedule& schedule() const { return schedule_; }
@@ -88,6 +94,12 @@ class GuidedPathTracer final : public CameraPathIntegrator {
                uint64_t* nonfinite) const override;
 
  private:
+  double seconds_since_start() const;
+  // After iteration i: when the next one starts a new pass, the schedule weighs the pass that
+  // ended, the field learns what it recorded, and the combiner folds it (at the end of a pass,
+  // not the start of the next, so that shared_iteration() knows what the next one does).
+  void end_pass_after(uint32_t iteration);
+
   IntegratorSettings settings_;
   PathTracer unguided_;  // renders when guiding did not pay (with --time: the schedule's trials)
   GuidingField field_;

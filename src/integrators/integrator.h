@@ -7,8 +7,10 @@
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
+#include <span>
 #include <string>
 
+#include "core/fixed_sum.h"
 #include "guiding/guiding_settings.h"
 #include "image/image.h"
 
@@ -75,10 +77,13 @@ class Integrator {
   // Integrator-specific statistics for the JSON output.
   virtual void report(nlohmann::json& stats) const { (void)stats; }
 
-  // Learning that every MPI rank shares (adaptive-vcm's probes): an iteration for which this is
-  // true teaches the integrator how to render later ones. The render loop has every rank render
-  // it, in global iteration order, so that each rank learns the same; only the rank that owns
-  // the iteration (iteration mod K) keeps its image. In one process nothing changes.
+  // Learning that every MPI rank shares (adaptive-vcm's probes, the training passes of the
+  // guided integrators): an iteration for which this is true teaches the integrator how to
+  // render later ones. The render loop has every rank render it, in global iteration order, so
+  // that each rank learns the same; only the rank that owns the iteration (iteration mod K)
+  // keeps its image in the film. In one process nothing changes. Asked for the iterations from
+  // the next one on, which the integrator must know by then (the guided ones decide at the end
+  // of a pass what the next does).
   virtual bool shared_iteration(uint32_t iteration) const {
     (void)iteration;
     return false;
@@ -88,6 +93,19 @@ class Integrator {
   // that what the integrator reads from the film does not depend on the number of ranks. An
   // integrator driven without the render loop reads its own film instead.
   virtual void observe_film(const Film& before) { (void)before; }
+  // Whether observe_film() is wanted: else the ranks meet before a shared iteration only to
+  // agree whether to stop, without summing their films.
+  virtual bool observes_film() const { return false; }
+
+  // A render split over MPI ranks calls this once on every rank after the last iteration, and
+  // adds the returned exact sums over the ranks into rank 0's before image() there, as it adds
+  // the films: what image() reads beside the film (guided-pt: its current pass). The span's
+  // length must be the same on every rank; `root`: this is rank 0 (a part that every rank
+  // holds whole, such as a pass of shared iterations, is cleared elsewhere). Default: none.
+  virtual std::span<FixedSum> sums_over_ranks(bool root) {
+    (void)root;
+    return {};
+  }
 
  protected:
   int budget_spp() const { return budget_spp_; }

@@ -36,15 +36,12 @@ std::vector<IntegratorInfo> make_registry() {
                "path tracing guided by incident radiance learned while rendering (Mueller 2017)",
                true, true, false, MisHeuristic::Power,
                [](const IntegratorSettings& s) { return std::make_unique<GuidedPathTracer>(s); }});
-  r.back().learns_while_rendering = true;
   r.push_back({"guided-bpt",
                "bpt with camera subpaths guided by learned radiance and light subpaths by learned "
                "importance (Vorba 2014), MIS over the guided densities",
                true, true, false, MisHeuristic::Balance, bidir(BidirAlgorithm::GuidedBpt)});
-  r.back().learns_while_rendering = true;
   r.push_back({"guided-vcm", "vcm with the guided subpaths of guided-bpt", false, true, true,
                MisHeuristic::Balance, bidir(BidirAlgorithm::GuidedVcm)});
-  r.back().learns_while_rendering = true;
   return r;
 }
 

@@ -27,12 +27,6 @@ struct IntegratorInfo {
   bool caustics_through_specular = false;
   MisHeuristic default_mis = MisHeuristic::Balance;  // when the user names none (--mis)
   std::function<std::unique_ptr<Integrator>(const IntegratorSettings&)> make;
-  // Learns from its own samples while rendering (path guiding): its image depends on every
-  // earlier iteration, so it cannot be split over MPI ranks until the learned structures are
-  // merged across ranks (not done yet); the command line refuses it with several ranks.
-  // (adaptive-vcm learns only from shared iterations, which every rank renders:
-  // Integrator::shared_iteration.)
-  bool learns_while_rendering = false;
 };
 
 // What `caustica render` and Python's render() use when neither the user nor the scene file

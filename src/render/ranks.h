@@ -8,7 +8,10 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
+
+#include "core/fixed_sum.h"
 
 namespace caustica {
 
@@ -49,6 +52,14 @@ class Ranks {
   // returns whether any rank passed stop = true, so that all ranks stop at one decision.
   virtual bool all_sum_films(const Film& mine, Film* total, bool stop) = 0;
 
+  // Collective, on all_sum_films' channel: whether any rank passed stop = true (the meeting
+  // before a shared iteration of an integrator that does not read the film).
+  virtual bool any_stops(bool stop) = 0;
+
+  // Collective. Replaces `sums` on rank 0 by its sum over the ranks (the same length on every
+  // rank; elsewhere it is left as it was): an integrator's own exact sums beside the film.
+  virtual void sum_to_root(std::span<FixedSum> sums) = 0;
+
   // Collective. Every rank passes its status (0: ready) and, when it failed, its message. All
   // return the largest status; rank 0 gets in *message the lowest failing rank's message
   // (empty if rank 0 failed itself: it has printed its own).
@@ -77,6 +88,8 @@ class SingleProcess final : public Ranks {
     sum_films(mine, total);
     return stop;
   }
+  bool any_stops(bool stop) override { return stop; }
+  void sum_to_root(std::span<FixedSum>) override {}
   int agree(int status, const std::string&, std::string* message) override {
     message->clear();
     return status;

@@ -18,7 +18,7 @@ namespace {
 
 // FixedSum is __int128, which MPI has no type or sum for: 16 contiguous bytes and our own op.
 // The op is exact integer addition, so it is associative and commutative, and MPI may reduce
-// in any tree it likes without changing a bit (film/fixed_sum.h).
+// in any tree it likes without changing a bit (core/fixed_sum.h).
 void add_fixed_sums(void* in, void* inout, int* len, MPI_Datatype*) {
   const char* a = static_cast<const char*>(in);
   char* b = static_cast<char*>(inout);
@@ -115,6 +115,22 @@ class MpiRanks final : public Ranks {
     MPI_Allreduce(counts, sum, 3, MPI_UINT64_T, MPI_SUM, learning_);
     total->set_counts(uint32_t(sum[0]), sum[1]);
     return sum[2] > 0;
+  }
+
+  bool any_stops(bool stop) override {
+    int mine = stop ? 1 : 0, any = 0;
+    MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, learning_);
+    return any > 0;
+  }
+
+  void sum_to_root(std::span<FixedSum> sums) override {
+    for (size_t at = 0; at < sums.size(); at += kPiece) {
+      const int n = int(std::min(kPiece, sums.size() - at));
+      if (rank_ == 0)
+        MPI_Reduce(MPI_IN_PLACE, sums.data() + at, n, fixed_type_, fixed_add_, 0, MPI_COMM_WORLD);
+      else
+        MPI_Reduce(sums.data() + at, nullptr, n, fixed_type_, fixed_add_, 0, MPI_COMM_WORLD);
+    }
   }
 
   int agree(int status, const std::string& mine, std::string* message) override {

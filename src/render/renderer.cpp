@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "film/film.h"
@@ -57,11 +58,13 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
       integrator.observe_film(film);
       return true;
     }
+    if (!integrator.observes_film()) return !ranks.any_stops(stopping);
     Film before(film.width(), film.height());
     if (ranks.all_sum_films(film, &before, stopping)) return false;
     integrator.observe_film(before);
     return true;
   };
+  std::optional<Film> scratch;  // the film of other ranks' shared iterations, never read
   RoundState totals;
   double next_checkpoint = callbacks.checkpoint_seconds;
   auto my_state = [&] {
@@ -129,8 +132,8 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
     }
     dealer.advance();
     if (!dealer.owns(iteration)) {  // someone else's shared iteration: learn, keep no image
-      Film scratch(film.width(), film.height());
-      integrator.render_iteration(scene, uint32_t(iteration), scratch);
+      if (!scratch) scratch.emplace(film.width(), film.height());
+      integrator.render_iteration(scene, uint32_t(iteration), *scratch);
       continue;
     }
     integrator.render_iteration(scene, uint32_t(iteration), film);
@@ -161,9 +164,13 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
     r.image = integrator.image(film);
     r.nonfinite = film.nonfinite_count();
   } else {
+    // What the integrator's image reads beside the film (a collective on every rank whenever
+    // the integrator has such sums: the same integrator everywhere).
+    const std::span<FixedSum> own = integrator.sums_over_ranks(ranks.is_root());
+    if (!own.empty()) ranks.sum_to_root(own);
     Film sum(film.width(), film.height());
     ranks.sum_films(film, &sum);
-    r.image = sum.image();
+    r.image = ranks.is_root() ? integrator.image(sum) : sum.image();
     r.nonfinite = sum.nonfinite_count();
   }
   return r;

@@ -159,10 +159,12 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
   // adaptive-vcm's probes are shared: every MPI rank renders them, and the means that normalise
   // their variances come from the film of all ranks (observe_film), so every rank makes the
-  // choice one process makes.
+  // choice one process makes. So are the training and trial passes of guided-bpt/guided-vcm:
+  // every rank learns the same fields and takes the same decisions (at a fixed --spp).
   bool shared_iteration(uint32_t iteration) const override {
-    return tech_.adaptive && plan_.is_probe(iteration);
+    return (tech_.adaptive && plan_.is_probe(iteration)) || (tech_.guided && guiding_.teaches());
   }
+  bool observes_film() const override { return tech_.adaptive; }
   void observe_film(const Film& before) override {
     observed_means_ = pixel_means(before);
     observed_ = true;

@@ -35,23 +35,24 @@ void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint
   radiance_records_ = importance_records_ = 0;
 }
 
-bool BidirGuiding::begin_iteration(uint32_t iteration, double elapsed,
-                                   const InverseVarianceCombiner& passes) {
+void BidirGuiding::begin_iteration(uint32_t iteration, double elapsed) {
   iteration_ = iteration;
-  bool new_pass = false;
-  if (schedule_.starts_pass(iteration, elapsed)) {
-    const bool learned = schedule_.ended_learning();
-    const int k = schedule_.ended_training_pass();
-    const std::vector<InverseVarianceCombiner::Pass> all = passes.passes();
-    schedule_.end_pass(all.empty() ? -1.0 : all.back().variance);
-    if (learned) {
-      radiance_.end_pass(k);
-      importance_.end_pass(k);
-    }
-    new_pass = true;
-  }
+  if (iteration == 0) schedule_.starts_pass(0, elapsed);
   if (schedule_.learning()) camera_records_.begin_iteration(pixels_ / camera_stride_ + 1);
-  return new_pass;
+}
+
+bool BidirGuiding::end_pass_after(uint32_t iteration, double elapsed,
+                                  const InverseVarianceCombiner& passes) {
+  if (!schedule_.starts_pass(iteration + 1, elapsed)) return false;
+  const bool learned = schedule_.ended_learning();
+  const int k = schedule_.ended_training_pass();
+  const std::vector<InverseVarianceCombiner::Pass> all = passes.passes();
+  schedule_.end_pass(all.empty() ? -1.0 : all.back().variance);
+  if (learned) {
+    radiance_.end_pass(k);
+    importance_.end_pass(k);
+  }
+  return true;
 }
 
 VertexGuides BidirGuiding::at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const {

@@ -67,10 +67,17 @@ class BidirGuiding {
                double seconds);
   bool enabled() const { return enabled_; }
 
-  // Before iteration i, `elapsed` seconds into the render: when i starts a new pass, the
-  // schedule weighs the pass that ended (its variance: the last of `passes`), its fields learn
-  // what it recorded, and true is returned (the caller then ends the pass in `passes`).
-  bool begin_iteration(uint32_t iteration, double elapsed, const InverseVarianceCombiner& passes);
+  // Before iteration i, `elapsed` seconds into the render.
+  void begin_iteration(uint32_t iteration, double elapsed);
+  // After iteration i and its pixel moments in `passes`: when the next iteration starts a new
+  // pass, the schedule weighs the pass that ended (its variance: the last of `passes`), its
+  // fields learn what it recorded, and true is returned (the caller then ends the pass in
+  // `passes`). At the end of a pass, not the start of the next, so that what the next
+  // iteration does is known before it starts (teaches()).
+  bool end_pass_after(uint32_t iteration, double elapsed, const InverseVarianceCombiner& passes);
+  // Whether the iterations from the next on teach the fields or decide the schedule (training
+  // and trial passes): every MPI rank renders them (Integrator::shared_iteration).
+  bool teaches() const { return enabled_ && !schedule_.final_pass(); }
   // The guides at a vertex at p with geometric normal ng and this BSDF (empty where it is not
   // guided).
   VertexGuides at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const;

@@ -117,8 +117,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   it.merge_normalization = n ? 1.f / (kPi * it.radius * it.radius * float(n)) : 0.f;
   it.light_path_of =
       LightPathAssignment(film.pixel_count(), std::max<uint64_t>(n, 1), iteration, settings_.seed);
-  if (tech_.guided && guiding_.begin_iteration(iteration, seconds_since(start_), guided_passes_))
-    guided_passes_.end_pass();
+  if (tech_.guided) guiding_.begin_iteration(iteration, seconds_since(start_));
   probe_ = {};
   probe_.light_paths = double(n);
   if (it.plan.probe) plan_.begin_probe(it.radius);
@@ -150,6 +149,8 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
     for (size_t p = 0; p < camera_values_.size(); ++p)
       guided_passes_.add(p, camera_values_[p] + splat_image_[p]);
     guided_passes_.end_iteration();
+    if (guiding_.end_pass_after(iteration, seconds_since(start_), guided_passes_))
+      guided_passes_.end_pass();
   }
   probe_.light_vertices = double(vertices_.size());
   add_counts(work_total_, probe_);

@@ -462,8 +462,8 @@ TEST(Guiding, InverseVarianceCurrentPassSumsOverProcessesExactly) {
   EXPECT_EQ(a.passes()[0].samples, 6u);
   EXPECT_EQ(a.passes()[0].variance, one.passes()[0].variance);
   // Pixel 0's variance of the mean is about (1e14 - 1e14 / 6) / 5 / 6 (the 1e7 sample), pixel
-  // 1's 0.7152^2 of that (the 1e7 in green), the pass's their mean (a square clamped at 2^31
-  // would leave 1e-5 of it).
+  // 1's 0.7152^2 of that (the 1e7 in green), the pass's their mean (with the squares clamped at
+  // 2^31 it came out 0).
   const double pixel0 = (1e14 - 1e14 / 6) / 5 / 6;
   EXPECT_NEAR(one.passes()[0].variance, 0.5 * (1 + 0.7152 * 0.7152) * pixel0, 0.01 * pixel0);
   a.clear_current();

@@ -102,7 +102,8 @@ std::unique_ptr<Scene> corners_scene() {
 }
 
 // Builds a random complete path by tracing a light subpath (Importance mode) of 1-4 surface
-// vertices whose last vertex the camera sees. Returns false if the walk failed.
+// vertices whose last vertex the camera sees, or (one in five) an area light's emission point
+// the camera sees directly. Returns false if the walk failed.
 bool random_path(const Scene& scene, Pcg32& rng, ScratchArena& arena, ExplicitPath* path) {
   float pmf;
   const Light* light = scene.light_sampler().sample(rng.next_float(), &pmf);
@@ -117,7 +118,20 @@ bool random_path(const Scene& scene, Pcg32& rng, ScratchArena& arena, ExplicitPa
   Vec3 o = le->p;
   if (light->type() == LightType::Area) o = o + face_forward(le->n, le->dir) * 1e-4f;
   Ray ray{o, le->dir, kInfinity};
-  const int vertices = 1 + int(rng.next_bounded(4));
+  const int vertices = int(rng.next_bounded(5));
+  if (vertices == 0) {  // the light seen from the lens
+    if (light->type() != LightType::Area) return false;
+    path->lens_point = scene.camera().position();
+    if (!scene.camera().is_pinhole()) {
+      const auto cs = scene.camera().sample_wi(le->p, rng.next_2d());
+      if (!cs) return false;
+      path->lens_point = cs->p_lens;
+    }
+    const Vec3 to_lens = normalize(path->lens_point - le->p);
+    return !light->radiance(le->p, le->n, {}, to_lens).is_black() &&
+           scene.camera().raster_of(path->lens_point, -to_lens).has_value() &&
+           camera_pdf_w(scene.camera(), path->lens_point, -to_lens) > 0;
+  }
   for (int i = 0; i < vertices; ++i) {
     SurfaceInteraction si;
     if (!scene.intersect(ray, &si) || !si.material) return false;
@@ -202,7 +216,7 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
   float pdf_pos, pdf_dir;
   light.pdf_le(x[0], finite ? path.light_normal : path.emit_dir, emit, &pdf_pos, &pdf_dir);
   light_pdf[0] = pmf * (finite ? pdf_pos : pdf_dir);
-  light_pdf[1] = finite ? pdf_dir * to_area(0, 1) : pdf_pos * cos_at(1, emit);
+  if (k >= 2) light_pdf[1] = finite ? pdf_dir * to_area(0, 1) : pdf_pos * cos_at(1, emit);
   for (int i = 1; i + 1 < k; ++i) {
     const Vec3 wo = i == 1 ? -emit : dir(i, i - 1);
     const double p = delta(i) ? 1.0 : pdf(i, wo, dir(i, i + 1), TransportMode::Importance);
@@ -216,8 +230,10 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
     const double p = delta(i) ? 1.0 : pdf(i, dir(i, i + 1), wi, TransportMode::Radiance);
     camera_pdf[i - 1] = p * to_area(i, i - 1);
   }
-  double nee_pdf;
-  if (light.is_delta())
+  double nee_pdf = 0;
+  if (k == 1)
+    ;  // no vertex to sample the light from
+  else if (light.is_delta())
     nee_pdf = pmf;
   else if (finite)
     nee_pdf = pmf * light.pdf_li(x[1], dir(1, 0), x[0], path.light_normal) * to_area(1, 0);
@@ -231,12 +247,14 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
   };
   std::map<Key, double> p;
   if (connect && !light.is_delta()) p[{false, 0, k + 1}] = prod(camera_pdf, 0, k - 1);
-  if (connect && !delta(1)) p[{false, 1, k}] = nee_pdf * prod(camera_pdf, 1, k - 1);
+  if (connect && k >= 2 && !delta(1)) p[{false, 1, k}] = nee_pdf * prod(camera_pdf, 1, k - 1);
   for (int s = 2; connect && s <= k - 1; ++s)
     if (!delta(s - 1) && !delta(s))
       p[{false, s, k + 1 - s}] =
           connections * prod(light_pdf, 0, s - 1) * prod(camera_pdf, s, k - 1);
-  if (connect && !delta(k - 1)) p[{false, k, 1}] = light_paths * prod(light_pdf, 0, k - 1);
+  // t = 1; for k = 1 the emission point of an area light itself (s = 1, t = 1).
+  if (connect && (k == 1 ? light.type() == LightType::Area : !delta(k - 1)))
+    p[{false, k, 1}] = light_paths * prod(light_pdf, 0, k - 1);
   for (int j = 1; merge && j <= k - 1; ++j)
     if (!delta(j))
       p[{true, j + 1, k + 1 - j}] =
@@ -317,7 +335,7 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
   const bool connect = c.algorithm != BidirAlgorithm::Bpm,
              merge = c.algorithm != BidirAlgorithm::Bpt &&
                      c.algorithm != BidirAlgorithm::GuidedBpt && c.pixel_merges;
-  int checked = 0, attempts = 0, with_delta = 0;
+  int checked = 0, attempts = 0, with_delta = 0, seen_directly = 0;
   double worst_sum = 0, worst_oracle = 0;
   ExplicitPath path;
   while (checked < paths && attempts < 50 * paths) {
@@ -346,6 +364,7 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
     }
     ASSERT_EQ(weights.size(), oracle.size()) << c.scene;
     worst_sum = std::max(worst_sum, std::abs(sum - 1));
+    seen_directly += path.surfaces.empty();
     for (const SurfaceInteraction& si : path.surfaces)
       if (si.material->bsdf(si, arena).is_delta()) {
         ++with_delta;
@@ -366,14 +385,20 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
     ++checked;
   }
   EXPECT_EQ(checked, paths) << c.scene << ": could not build enough paths";
+  // Area lights seen straight from the lens (s = 0 against s = 1, t = 1) are among the paths.
+  bool area_lights = false;
+  for (const Light* l : scene.lights()) area_lights |= l->type() == LightType::Area;
+  if (area_lights && connect) {
+    EXPECT_GT(seen_directly, paths / 50) << c.scene;
+  }
   // The guided cases must exercise guided densities: on average a guided vertex per two paths.
   if (guiding) {
     EXPECT_GT(2 * guided_vertices, paths) << c.scene;
   }
   std::printf(
-      "[ partition ] %-14s %d paths (%d through delta vertices), max |sum - 1| = %.2e, max |w - "
-      "oracle| = %.2e\n",
-      c.scene, checked, with_delta, worst_sum, worst_oracle);
+      "[ partition ] %-14s %d paths (%d through delta vertices, %d lights seen directly), max "
+      "|sum - 1| = %.2e, max |w - oracle| = %.2e\n",
+      c.scene, checked, with_delta, seen_directly, worst_sum, worst_oracle);
 }
 
 std::unique_ptr<Scene> scene_named(const std::string& name) {

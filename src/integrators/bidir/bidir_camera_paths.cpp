@@ -88,12 +88,22 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   bool specular_path = true;  // every bounce so far was specular
   float segment = 0;
   float eta_scale = 1;
-  // Emitters: MIS-weighted when connections take part, else only via delta-only chains.
+  bool through_interface = false;  // the ray passed a surface without a BSDF
+  // Emitters: MIS-weighted when connections take part, else only via delta-only chains. An
+  // area light seen straight from the lens is weighted against the light subpaths' emission
+  // points connected to the lens, unless the ray passed an interface (that connection's shadow
+  // ray stops there).
   TechniqueTerms terms;
   bool weighted = false;  // the last emitter weight came from terms
   auto emitter_weight = [&](const Light& light, const SurfaceInteraction* hit, const MisSums& m) {
     weighted = false;
-    if (depth == 0) return 1.f;
+    if (depth == 0) {
+      if (!hit || !tech_.light_origin || through_interface || light.type() != LightType::Area)
+        return 1.f;
+      weighted = true;
+      terms = terms_light_seen_from_lens(rules, light, lights.pmf(&light), *hit, m);
+      return terms.weight(rules.counts());
+    }
     if (!tech_.connect) return specular_path ? 1.f : 0.f;
     weighted = true;
     terms = terms_emitter_hit(rules, light, lights.pmf(&light), prev_p, ray.d, hit, m);
@@ -121,6 +131,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     });
     if (!bsdf.valid()) {
       ray = si.spawn_ray(ray.d);
+      through_interface = true;
       continue;
     }
     ++depth;

@@ -42,6 +42,7 @@ constexpr float kDefaultRadiusFactor = 0.003f;
 // Which techniques take part (tech. rep. section 6, SmallVCM's switches).
 struct Techniques {
   bool light_to_camera = false;  // t = 1 splats
+  bool light_origin = false;     // ... including area lights' emission points (s = 1, t = 1)
   bool connect = false;          // NEE, emitter hits and connections, MIS-weighted
   bool merge = false;            // vertex merging
   bool camera_stops = false;     // camera subpaths end at their first non-delta vertex
@@ -197,6 +198,11 @@ class BidirIntegrator final : public CameraPathIntegrator {
   void trace_light_path(const Scene& scene, const Iteration& it, uint64_t path, LightChunk& chunk,
                         ScratchArena& arena) const;
 
+  // s = 1, t = 1: an area light's emission point seen through a lens point (the light seen
+  // directly, the other way than a camera ray hitting it); splats recorded in the chunk.
+  void connect_emission_to_camera(const Scene& scene, const Iteration& it, const Light& light,
+                                  float pmf, const LightLeSample& le, uint64_t path,
+                                  LightChunk& chunk) const;
   // t = 1: the light vertex seen through a lens point; splat recorded in the chunk.
   void connect_to_camera(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
                          const Bsdf& bsdf, const VertexGuides& guides, Rgb beta, const MisSums& mis,

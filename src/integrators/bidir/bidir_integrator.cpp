@@ -41,6 +41,9 @@ Techniques techniques_of(BidirAlgorithm a) {
       t.light_to_camera = t.connect = t.merge = t.guided = true;
       break;
   }
+  // MIS-weighted light tracing also connects the emission points (lt's unweighted splats leave
+  // the directly seen lights to its camera rays).
+  t.light_origin = t.light_to_camera && t.connect;
   return t;
 }
 

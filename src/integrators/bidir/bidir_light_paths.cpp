@@ -136,6 +136,8 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
   if (!light || !(pmf > 0)) return;
   const auto le = light->sample_le(u_pos, u_dir);
   if (!le || !(le->pdf_pos > 0) || !(le->pdf_dir > 0) || le->radiance.is_black()) return;
+  if (tech_.light_origin && light->type() == LightType::Area)
+    connect_emission_to_camera(scene, it, *light, pmf, *le, path, chunk);
   const float emission_pdf = pmf * le->pdf_pos * le->pdf_dir;
   Rgb beta = le->radiance * (le->cos_at_light / emission_pdf);
   Rgb rr_beta = beta;  // the throughput BSDF sampling alone would have (guided roulette)
@@ -193,6 +195,48 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
       beta = beta / (1 - q);
       rr_beta = rr_beta / (1 - q);
     }
+  }
+}
+
+void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Iteration& it,
+                                                 const Light& light, float pmf,
+                                                 const LightLeSample& le, uint64_t path,
+                                                 LightChunk& chunk) const {
+  const Camera& camera = scene.camera();
+  // A stream of its own: the light subpaths draw the numbers they drew without this technique.
+  Pcg32 rng = Pcg32::for_sample(path, it.index, hash_combine(settings_.seed, 0x1e4ull));
+  const auto cs = camera.sample_wi(le.p, rng.next_2d());
+  if (!cs || !(cs->importance > 0)) return;
+  const Rgb radiance = light.radiance(le.p, le.n, {}, cs->wi);
+  if (radiance.is_black()) return;
+  const float pos_pdf = pmf * le.pdf_pos;
+  const LensConnection lens = lens_connection_of_emission(camera, le.p, le.n, cs->p_lens);
+  // Le G We / (pmf pdf_pos) per light path, in connect_to_camera's units (G = cos_light / pdf_w
+  // with pdf_w the lens point's solid-angle density at the light point).
+  const float scale = lens.cos_at_vertex * cs->importance * float(camera.pixel_count()) /
+                      (cs->pdf_w * float(it.plan.light_paths) * pos_pdf);
+  const size_t first_splat = chunk.splats.size();
+  filter_.for_each_pixel(
+      cs->raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
+        const uint32_t pixel = uint32_t(y * camera.width() + x);
+        if (tech_.adaptive && it.plan.path_traces(pixel)) return;  // pt's estimator alone there
+        const MisRules& rules = it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
+        const TechniqueTerms terms = terms_light_origin_to_camera(rules, lens, pos_pdf, fs.pdf);
+        const Rgb value = radiance * (scale * terms.weight(rules.counts())) * (fs.weight * fs.pdf);
+        if (value.is_black()) return;
+        if (!value.is_finite()) {
+          ++chunk.nonfinite;
+          return;
+        }
+        chunk.splats.push_back({pixel, TechniqueImages::key(false, 1, 1), value});
+        if (it.plan.probe) chunk.splat_terms.push_back(terms);
+      });
+  if (chunk.splats.size() == first_splat) return;
+  const Vec3 o =
+      le.p + face_forward(le.n, cs->wi) * (1e-4f * std::max(1.f, max_component(abs(le.p))));
+  if (scene.occluded({o, cs->p_lens - o, 1.f - 1e-4f})) {
+    chunk.splats.resize(first_splat);
+    if (it.plan.probe) chunk.splat_terms.resize(first_splat);
   }
 }
 

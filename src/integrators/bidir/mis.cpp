@@ -148,6 +148,21 @@ TechniqueTerms MisRules::hit_light(const MisSums& camera, float direct_pdf,
   return t;
 }
 
+TechniqueTerms MisRules::hit_light_from_lens(const MisSums& camera, float emission_pos_pdf) const {
+  // camera.vcm is 1 / p_camera in area measure at the light (camera_start, then hit()).
+  TechniqueTerms t;
+  t.own = TechniqueClass::Emitter;
+  t.light_trace = times(mis(emission_pos_pdf), camera.vcm);
+  return t;
+}
+
+TechniqueTerms MisRules::light_origin_to_camera(float camera_pdf_a, float emission_pos_pdf) const {
+  TechniqueTerms t;
+  t.own = TechniqueClass::LightTrace;
+  t.emitter = mis(camera_pdf_a / emission_pos_pdf);
+  return t;
+}
+
 TechniqueTerms MisRules::next_event(const MisSums& camera, float bsdf_pdf_fwd, float bsdf_pdf_rev,
                                     float direct_pdf_w, float emission_pdf_w, float cos_to_light,
                                     float cos_at_light) const {

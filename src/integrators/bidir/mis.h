@@ -4,7 +4,9 @@
 //
 //   emitter      the camera subpath hits an emitter (s = 0) or connects to a light sample
 //                (s = 1, NEE): one sample each per camera vertex, or none (bpm);
-//   light_trace  a light vertex connected to the lens (t = 1): N light paths per pixel;
+//   light_trace  a light vertex connected to the lens (t = 1): N light paths per pixel; this
+//                includes the emission point of an area light itself (s = 1, t = 1), the
+//                other way to see a light directly than the camera ray hitting it (s = 0, t = 2);
 //   connect      a light vertex connected to a camera vertex (s, t >= 2): c per camera vertex;
 //   merge        vertex merging: N pi r^2 per camera vertex (acceptance area x light paths),
 //                or 0 in a pixel that does not merge.
@@ -113,6 +115,13 @@ class MisRules {
   // Camera subpath hits an emitter (s = 0): direct_pdf in the measure of light_first_hit
   // (area, or solid angle for infinite lights), emission_pdf = pmf * pdf_pos * pdf_dir.
   TechniqueTerms hit_light(const MisSums& camera, float direct_pdf, float emission_pdf) const;
+  // The camera ray itself hits an area light (s = 0, t = 2): the one other technique is the
+  // light subpaths' emission point connected to the lens (s = 1, t = 1). emission_pos_pdf:
+  // pmf * pdf_pos of that point (area measure); `camera` the sums after hit() at the light.
+  TechniqueTerms hit_light_from_lens(const MisSums& camera, float emission_pos_pdf) const;
+  // The converse: a light subpath's emission point connected to the lens (s = 1, t = 1);
+  // camera_pdf_a: the per-pixel camera density of the point in area measure.
+  TechniqueTerms light_origin_to_camera(float camera_pdf_a, float emission_pos_pdf) const;
   // Next event estimation (s = 1). bsdf_pdf_fwd is 0 for delta lights; direct_pdf_w includes the
   // pmf and is pmf * dist^2 for delta positions (area density 1); cos_to_light = |ng . wi| at the
   // camera vertex; cos_at_light = 1 for point-like and infinite lights. eqs. 44-45.

@@ -28,6 +28,27 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   const float pmf = scene.light_sampler().pmf(&light);
   const bool finite = !light.is_infinite();
   const int k = int(path.surfaces.size()) + 1;  // segments
+  if (k == 1) {
+    // An area light seen straight from the lens: the camera ray hitting it (s = 0) and its
+    // emission point connected to the lens (s = 1, t = 1).
+    if (!connect || light.type() != LightType::Area) return {};
+    SurfaceInteraction emitter;
+    emitter.p = path.light_point;
+    emitter.ng = path.light_normal;
+    emitter.wo = normalize(path.lens_point - path.light_point);
+    MisSums m = rules.camera_start(
+        camera_pdf_w(scene.camera(), path.lens_point, -emitter.wo, raster_density));
+    rules.hit(m, distance_squared(path.lens_point, emitter.p), geometric_cos(emitter, emitter.wo));
+    float pdf_pos, pdf_dir;
+    light.pdf_le(emitter.p, emitter.ng, emitter.wo, &pdf_pos, &pdf_dir);
+    const LensConnection lens =
+        lens_connection_of_emission(scene.camera(), emitter.p, emitter.ng, path.lens_point);
+    return {{false, 0, 2,
+             terms_light_seen_from_lens(rules, light, pmf, emitter, m).weight(rules.counts())},
+            {false, 1, 1,
+             terms_light_origin_to_camera(rules, lens, pmf * pdf_pos, raster_density)
+                 .weight(rules.counts())}};
+  }
 
   // Positions x0..xk; for infinite lights x0 is a point far back along the emission direction.
   std::vector<Vec3> x(k + 1);

@@ -56,6 +56,13 @@ TechniqueTerms terms_emitter_hit(const MisRules& rules, const Light& light, floa
   return rules.hit_light(camera, direct, pmf * pdf_pos * pdf_dir);
 }
 
+TechniqueTerms terms_light_seen_from_lens(const MisRules& rules, const Light& light, float pmf,
+                                          const SurfaceInteraction& hit, const MisSums& camera) {
+  float pdf_pos = 0, pdf_dir = 0;
+  light.pdf_le(hit.p, hit.ng, hit.wo, &pdf_pos, &pdf_dir);
+  return rules.hit_light_from_lens(camera, pmf * pdf_pos);
+}
+
 TechniqueTerms terms_next_event(const MisRules& rules, const Light& light, float pmf,
                                 const LightLiSample& ls, const SurfaceInteraction& si,
                                 const Bsdf& bsdf, const MisSums& camera,
@@ -122,6 +129,24 @@ TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera
                                      const VertexGuides& guides) {
   return terms_light_to_camera(rules, lens_connection(camera, si, bsdf, wo, p_lens, guides), light,
                                raster_density);
+}
+
+LensConnection lens_connection_of_emission(const Camera& camera, Vec3 p, Vec3 n, Vec3 p_lens) {
+  const Vec3 d = p_lens - p;
+  LensConnection c;
+  c.dist2 = length_squared(d);
+  const Vec3 dir = d / std::sqrt(c.dist2);
+  float pdf_pos, pdf_dir;
+  camera.pdf_we(p_lens, -dir, &pdf_pos, &pdf_dir);
+  c.pixels_pdf_dir = float(camera.pixel_count()) * pdf_dir;
+  c.cos_at_vertex = abs_dot(n, dir);
+  return c;
+}
+
+TechniqueTerms terms_light_origin_to_camera(const MisRules& rules, const LensConnection& c,
+                                            float emission_pos_pdf, float raster_density) {
+  const float camera_pdf_a = c.pixels_pdf_dir * raster_density * c.cos_at_vertex / c.dist2;
+  return rules.light_origin_to_camera(camera_pdf_a, emission_pos_pdf);
 }
 
 TechniqueTerms terms_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,

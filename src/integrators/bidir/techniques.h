@@ -43,6 +43,11 @@ void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteractio
 // emitter (after hit() for area lights, before it for infinite ones).
 TechniqueTerms terms_emitter_hit(const MisRules& rules, const Light& light, float pmf, Vec3 prev_p,
                                  Vec3 dir, const SurfaceInteraction* hit, const MisSums& camera);
+// The camera ray hits an area light straight from the lens (s = 0, t = 2): weighted against the
+// light subpaths' emission points connected to the lens (s = 1, t = 1). `camera`: the sums at
+// the light (after hit()).
+TechniqueTerms terms_light_seen_from_lens(const MisRules& rules, const Light& light, float pmf,
+                                          const SurfaceInteraction& hit, const MisSums& camera);
 // Next event estimation from camera vertex (si, bsdf) with wo.
 TechniqueTerms terms_next_event(const MisRules& rules, const Light& light, float pmf,
                                 const LightLiSample& ls, const SurfaceInteraction& si,
@@ -72,6 +77,11 @@ TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera
                                      const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
                                      const MisSums& light, Vec3 p_lens, float raster_density = 1.f,
                                      const VertexGuides& guides = {});
+// An area light's emission point p (geometric normal n) connected to the lens point p_lens
+// (s = 1, t = 1); emission_pos_pdf = pmf * pdf_pos. The connection's rev is unused.
+LensConnection lens_connection_of_emission(const Camera& camera, Vec3 p, Vec3 n, Vec3 p_lens);
+TechniqueTerms terms_light_origin_to_camera(const MisRules& rules, const LensConnection& c,
+                                            float emission_pos_pdf, float raster_density = 1.f);
 // Merge of a light vertex that arrived along light_wo with a camera vertex.
 TechniqueTerms terms_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,
                            const SurfaceInteraction& camera_si, const Bsdf& camera_bsdf,

@@ -35,6 +35,10 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
            "Guiding (guided-bpt, guided-vcm): guide both subpaths, or only camera subpaths (by "
            "the radiance learned from light vertices) or only light subpaths (by the importance "
            "learned from camera vertices) (default both)");
+  o.choice("--guiding-mis", &s->guiding_mis, {"mixture", "bsdf"},
+           "Guiding (guided-bpt, guided-vcm): MIS weights from the guided mixtures' densities "
+           "or from the BSDFs' alone, as unguided bpt/vcm (both unbiased; default bsdf: no guide "
+           "densities outside sampling)");
   o.choice("--guiding-combine", &s->guiding_combine, {"inverse-variance", "equal"},
            "Guiding: weight the training passes in the image by inverse variance, or every "
            "iteration equally (default inverse-variance)");
@@ -131,6 +135,7 @@ int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene,
   settings->guiding.inverse_variance = s.guiding_combine == "inverse-variance";
   settings->guiding.guide_camera_paths = s.guiding_subpaths != "light";
   settings->guiding.guide_light_paths = s.guiding_subpaths != "camera";
+  settings->guiding.guided_mis = s.guiding_mis == "mixture";
   return 0;
 }
 

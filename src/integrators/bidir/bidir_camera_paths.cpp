@@ -82,7 +82,8 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   const uint64_t light_path = it.light_path_of.light_path(pixel);
 
   Rgb beta(1.f);
-  Rgb rr_beta(1.f);  // the throughput BSDF sampling alone would have (guided roulette)
+  Rgb rr_beta(1.f);             // the throughput BSDF sampling alone would have (guided roulette)
+  const VertexGuides unguided;  // the MIS densities' guides without guided_mis()
   Vec3 prev_p = ray.o;
   int depth = 0;              // surface vertices so far
   bool specular_path = true;  // every bounce so far was specular
@@ -143,16 +144,16 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     ++acc.work.camera_vertices;
     const VertexGuides guides = tech_.guided ? guiding_.at(si.p, si.ng, bsdf) : VertexGuides{};
     if (!delta) {
-      vertex_techniques(scene, it, {si, bsdf, beta, mis, depth, guides}, light_path, rng, arena,
-                        acc);
+      vertex_techniques(scene, it, {si, bsdf, beta, mis, depth, guided_mis() ? guides : unguided},
+                        light_path, rng, arena, acc);
       // Importance arriving straight from the lens (directly or through specular bounces only)
       // is what light tracing connects to; a light subpath scattered toward it finds nothing.
       if (tech_.guided && !specular_path && guiding_.records_pixel(pixel))
         guiding_.record_camera_vertex(pixel, depth, si.p, si.ng, si.wo, beta);
     }
 
-    const auto step =
-        scatter_subpath(rules, mis, si, bsdf, guides, TransportMode::Radiance, rng, beta, rr_beta);
+    const auto step = scatter_subpath(rules, mis, si, bsdf, guides, TransportMode::Radiance, rng,
+                                      beta, rr_beta, guided_mis());
     if (!step) break;
     // PPM / lt: the non-delta part of this vertex was estimated by merging (or belongs to light
     // tracing); only its delta lobes carry the camera path on.
@@ -253,7 +254,7 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
     if (!own || !rebuilt.built) {
       rebuilt.si = scene.interaction_at(v.primitive, v.p, v.wo);
       rebuilt.bsdf = rebuilt.si.material->bsdf(rebuilt.si, arena);
-      rebuilt.guides = tech_.guided && rebuilt.bsdf.valid()
+      rebuilt.guides = guided_mis() && rebuilt.bsdf.valid()
                            ? guiding_.at(rebuilt.si.p, rebuilt.si.ng, rebuilt.bsdf)
                            : VertexGuides{};
       rebuilt.built = true;

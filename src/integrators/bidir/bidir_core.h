@@ -275,6 +275,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
   BidirAlgorithm algorithm_;
   Techniques tech_;
   IntegratorSettings settings_;
+  // Whether the MIS densities are the guided mixtures' (GuidingSettings::guided_mis).
+  bool guided_mis() const { return tech_.guided && settings_.guiding.guided_mis; }
   MisHeuristic heuristic_;
   PixelFilter filter_;  // the scene camera's, set by prepare(): light-tracing splats
   Iteration current_;   // this iteration's constants, for estimate()

@@ -174,12 +174,13 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
             pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}));
       }
       if (tech_.light_to_camera)
-        connect_to_camera(scene, it, si, bsdf, guides, beta, mis, depth, rng, chunk);
+        connect_to_camera(scene, it, si, bsdf, guided_mis() ? guides : VertexGuides{}, beta, mis,
+                          depth, rng, chunk);
     }
     if (depth + 1 > max_depth) break;
 
     const auto step = scatter_subpath(it.rules, mis, si, bsdf, guides, TransportMode::Importance,
-                                      rng, beta, rr_beta);
+                                      rng, beta, rr_beta, guided_mis());
     if (!step) break;
     if (beta.is_black()) break;
     ray = si.spawn_ray(step->wi);

@@ -5,15 +5,18 @@ namespace caustica::bidir {
 std::optional<SubpathStep> scatter_subpath(const MisRules& rules, MisSums& mis,
                                            const SurfaceInteraction& si, const Bsdf& bsdf,
                                            const VertexGuides& guides, TransportMode mode,
-                                           Pcg32& rng, Rgb& beta, Rgb& rr_beta) {
+                                           Pcg32& rng, Rgb& beta, Rgb& rr_beta, bool guided_mis) {
   SubpathStep step;
+  const VertexGuides unguided;
+  const VertexGuides& mis_guides = guided_mis ? guides : unguided;
   if (guides.guide(mode, si.wo)) {
     const float u_technique = rng.next_float(), uc = rng.next_float();
     const auto gs = sample_guided(bsdf, guides, si.wo, mode, u_technique, uc, rng.next_2d());
     if (!gs) return std::nullopt;
     step.wi = gs->wi;
     step.eta = gs->eta;
-    scatter_update(rules, mis, si, bsdf, si.wo, step.wi, mode, false, gs->pdf, guides);
+    scatter_update(rules, mis, si, bsdf, si.wo, step.wi, mode, false,
+                   guided_mis ? gs->pdf : gs->bsdf_pdf, mis_guides);
     beta *= gs->weight;
     rr_beta *= gs->bsdf_weight;
     return step;
@@ -25,8 +28,8 @@ std::optional<SubpathStep> scatter_subpath(const MisRules& rules, MisSums& mis,
   step.specular = bs->is_specular();
   if (bs->is_transmission()) step.eta = bs->eta;
   const float pdf_fwd =
-      bs->pdf_is_proportional ? direction_pdf(bsdf, guides, si.wo, step.wi, mode) : bs->pdf;
-  scatter_update(rules, mis, si, bsdf, si.wo, step.wi, mode, step.specular, pdf_fwd, guides);
+      bs->pdf_is_proportional ? direction_pdf(bsdf, mis_guides, si.wo, step.wi, mode) : bs->pdf;
+  scatter_update(rules, mis, si, bsdf, si.wo, step.wi, mode, step.specular, pdf_fwd, mis_guides);
   const Rgb weight = bs->f * (bsdf.abs_cos(step.wi) / bs->pdf);
   beta *= weight;
   rr_beta *= weight;

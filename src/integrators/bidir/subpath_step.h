@@ -18,10 +18,12 @@ struct SubpathStep {
 };
 
 // beta *= f |cos| / pdf; rr_beta *= f |cos| / p_bsdf (what BSDF sampling alone would give, for
-// guided Russian roulette). nullopt: the subpath ends here.
+// guided Russian roulette). guided_mis: the MIS sums take the mixture's densities (else the
+// BSDF's alone; GuidingSettings::guided_mis). nullopt: the subpath ends here.
 std::optional<SubpathStep> scatter_subpath(const MisRules& rules, MisSums& mis,
                                            const SurfaceInteraction& si, const Bsdf& bsdf,
                                            const VertexGuides& guides, TransportMode mode,
-                                           Pcg32& rng, Rgb& beta, Rgb& rr_beta);
+                                           Pcg32& rng, Rgb& beta, Rgb& rr_beta,
+                                           bool guided_mis = true);
 
 }  // namespace caustica::bidir

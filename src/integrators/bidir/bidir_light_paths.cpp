@@ -199,6 +199,35 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
   }
 }
 
+template <typename ValueOf, typename TermsOf>
+bool BidirIntegrator::splat_lens_connection(const Camera& camera, const Iteration& it, Vec2 raster,
+                                            uint32_t technique, const ValueOf& value_of,
+                                            const TermsOf& terms_of, LightChunk& chunk) const {
+  const size_t first_splat = chunk.splats.size();
+  filter_.for_each_pixel(
+      raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
+        const uint32_t pixel = uint32_t(y * camera.width() + x);
+        if (tech_.adaptive && it.plan.path_traces(pixel)) return;  // pt's estimator alone there
+        const MisRules& rules = it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
+        const TechniqueTerms terms = terms_of(rules, fs.pdf);
+        const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
+        const Rgb value = value_of(w) * (fs.weight * fs.pdf);
+        if (value.is_black()) return;
+        if (!value.is_finite()) {
+          ++chunk.nonfinite;
+          return;
+        }
+        chunk.splats.push_back({pixel, technique, value});
+        if (it.plan.probe) chunk.splat_terms.push_back(terms);
+      });
+  return chunk.splats.size() > first_splat;
+}
+
+void BidirIntegrator::drop_splats_from(size_t first, LightChunk& chunk) {
+  chunk.splats.resize(first);
+  if (chunk.splat_terms.size() > first) chunk.splat_terms.resize(first);
+}
+
 void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Iteration& it,
                                                  const Light& light, float pmf,
                                                  const LightLeSample& le, uint64_t path,
@@ -217,28 +246,17 @@ void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Itera
   const float scale = lens.cos_at_vertex * cs->importance * float(camera.pixel_count()) /
                       (cs->pdf_w * float(it.plan.light_paths) * pos_pdf);
   const size_t first_splat = chunk.splats.size();
-  filter_.for_each_pixel(
-      cs->raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
-        const uint32_t pixel = uint32_t(y * camera.width() + x);
-        if (tech_.adaptive && it.plan.path_traces(pixel)) return;  // pt's estimator alone there
-        const MisRules& rules = it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
-        const TechniqueTerms terms = terms_light_origin_to_camera(rules, lens, pos_pdf, fs.pdf);
-        const Rgb value = radiance * (scale * terms.weight(rules.counts())) * (fs.weight * fs.pdf);
-        if (value.is_black()) return;
-        if (!value.is_finite()) {
-          ++chunk.nonfinite;
-          return;
-        }
-        chunk.splats.push_back({pixel, TechniqueImages::key(false, 1, 1), value});
-        if (it.plan.probe) chunk.splat_terms.push_back(terms);
-      });
-  if (chunk.splats.size() == first_splat) return;
+  const bool splatted = splat_lens_connection(
+      camera, it, cs->raster, TechniqueImages::key(false, 1, 1),
+      [&](float w) { return radiance * (scale * w); },
+      [&](const MisRules& rules, float raster_density) {
+        return terms_light_origin_to_camera(rules, lens, pos_pdf, raster_density);
+      },
+      chunk);
+  if (!splatted) return;
   const Vec3 o =
       le.p + face_forward(le.n, cs->wi) * (1e-4f * std::max(1.f, max_component(abs(le.p))));
-  if (scene.occluded({o, cs->p_lens - o, 1.f - 1e-4f})) {
-    chunk.splats.resize(first_splat);
-    if (it.plan.probe) chunk.splat_terms.resize(first_splat);
-  }
+  if (scene.occluded({o, cs->p_lens - o, 1.f - 1e-4f})) drop_splats_from(first_splat, chunk);
 }
 
 void BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
@@ -257,26 +275,14 @@ void BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
       cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(it.plan.light_paths));
   const size_t first_splat = chunk.splats.size();
   const LensConnection lens = lens_connection(camera, si, bsdf, si.wo, cs->p_lens, guides);
-  filter_.for_each_pixel(
-      cs->raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
-        const uint32_t pixel = uint32_t(y * camera.width() + x);
-        if (tech_.adaptive && it.plan.path_traces(pixel)) return;  // pt's estimator alone there
-        const MisRules& rules = it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
-        const TechniqueTerms terms = terms_light_to_camera(rules, lens, mis, fs.pdf);
-        const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
-        const Rgb value = beta * f * (scale * w) * (fs.weight * fs.pdf);
-        if (value.is_black()) return;
-        if (!value.is_finite()) {
-          ++chunk.nonfinite;
-          return;
-        }
-        chunk.splats.push_back({pixel, TechniqueImages::key(false, depth + 1, 1), value});
-        if (it.plan.probe) chunk.splat_terms.push_back(terms);
-      });
-  if (chunk.splats.size() > first_splat && scene.occluded(si.spawn_ray_to(cs->p_lens))) {
-    chunk.splats.resize(first_splat);
-    if (it.plan.probe) chunk.splat_terms.resize(first_splat);
-  }
+  const bool splatted = splat_lens_connection(
+      camera, it, cs->raster, TechniqueImages::key(false, depth + 1, 1),
+      [&](float w) { return beta * f * (scale * w); },
+      [&](const MisRules& rules, float raster_density) {
+        return terms_light_to_camera(rules, lens, mis, raster_density);
+      },
+      chunk);
+  if (splatted && scene.occluded(si.spawn_ray_to(cs->p_lens))) drop_splats_from(first_splat, chunk);
 }
 
 }  // namespace caustica::bidir

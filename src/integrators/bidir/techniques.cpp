@@ -102,34 +102,13 @@ TechniqueTerms terms_connection(const MisRules& rules, const SurfaceInteraction&
   return rules.connect(light, camera, camera_pdf_a, camera_rev, light_pdf_a, light_rev);
 }
 
-LensConnection lens_connection(const Camera& camera, const SurfaceInteraction& si, const Bsdf& bsdf,
-                               Vec3 wo, Vec3 p_lens, const VertexGuides& guides) {
-  const Vec3 d = p_lens - si.p;
-  LensConnection c;
-  c.dist2 = length_squared(d);
-  const Vec3 dir = d / std::sqrt(c.dist2);
-  float pdf_pos, pdf_dir;
-  camera.pdf_we(p_lens, -dir, &pdf_pos, &pdf_dir);
-  c.pixels_pdf_dir = float(camera.pixel_count()) * pdf_dir;
-  c.cos_at_vertex = geometric_cos(si, dir);
-  c.rev = direction_pdf(bsdf, guides, dir, wo, TransportMode::Radiance);
-  return c;
+namespace {
+// The per-pixel camera density of the connected point in area measure: camera_pdf_w's value
+// (pixel_count x pdf_dir x raster density), in its order of operations, times cos / d^2.
+float camera_pdf_a(const LensConnection& c, float raster_density) {
+  return c.pixels_pdf_dir * raster_density * c.cos_at_vertex / c.dist2;
 }
-
-TechniqueTerms terms_light_to_camera(const MisRules& rules, const LensConnection& c,
-                                     const MisSums& light, float raster_density) {
-  // camera_pdf_w's value (pixel_count x pdf_dir x raster density), in its order of operations.
-  const float camera_pdf_a = c.pixels_pdf_dir * raster_density * c.cos_at_vertex / c.dist2;
-  return rules.light_to_camera(light, camera_pdf_a, c.rev);
-}
-
-TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera,
-                                     const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
-                                     const MisSums& light, Vec3 p_lens, float raster_density,
-                                     const VertexGuides& guides) {
-  return terms_light_to_camera(rules, lens_connection(camera, si, bsdf, wo, p_lens, guides), light,
-                               raster_density);
-}
+}  // namespace
 
 LensConnection lens_connection_of_emission(const Camera& camera, Vec3 p, Vec3 n, Vec3 p_lens) {
   const Vec3 d = p_lens - p;
@@ -143,10 +122,30 @@ LensConnection lens_connection_of_emission(const Camera& camera, Vec3 p, Vec3 n,
   return c;
 }
 
+LensConnection lens_connection(const Camera& camera, const SurfaceInteraction& si, const Bsdf& bsdf,
+                               Vec3 wo, Vec3 p_lens, const VertexGuides& guides) {
+  LensConnection c = lens_connection_of_emission(camera, si.p, si.ng, p_lens);
+  const Vec3 dir = (p_lens - si.p) / std::sqrt(c.dist2);  // as lens_connection_of_emission's
+  c.rev = direction_pdf(bsdf, guides, dir, wo, TransportMode::Radiance);
+  return c;
+}
+
+TechniqueTerms terms_light_to_camera(const MisRules& rules, const LensConnection& c,
+                                     const MisSums& light, float raster_density) {
+  return rules.light_to_camera(light, camera_pdf_a(c, raster_density), c.rev);
+}
+
+TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera,
+                                     const SurfaceInteraction& si, const Bsdf& bsdf, Vec3 wo,
+                                     const MisSums& light, Vec3 p_lens, float raster_density,
+                                     const VertexGuides& guides) {
+  return terms_light_to_camera(rules, lens_connection(camera, si, bsdf, wo, p_lens, guides), light,
+                               raster_density);
+}
+
 TechniqueTerms terms_light_origin_to_camera(const MisRules& rules, const LensConnection& c,
                                             float emission_pos_pdf, float raster_density) {
-  const float camera_pdf_a = c.pixels_pdf_dir * raster_density * c.cos_at_vertex / c.dist2;
-  return rules.light_origin_to_camera(camera_pdf_a, emission_pos_pdf);
+  return rules.light_origin_to_camera(camera_pdf_a(c, raster_density), emission_pos_pdf);
 }
 
 TechniqueTerms terms_merge(const MisRules& rules, Vec3 light_wo, const MisSums& light,

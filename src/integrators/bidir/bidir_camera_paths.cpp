@@ -82,8 +82,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   const uint64_t light_path = it.light_path_of.light_path(pixel);
 
   Rgb beta(1.f);
-  Rgb rr_beta(1.f);             // the throughput BSDF sampling alone would have (guided roulette)
-  const VertexGuides unguided;  // the MIS densities' guides without guided_mis()
+  Rgb rr_beta(1.f);  // the throughput BSDF sampling alone would have (guided roulette)
   Vec3 prev_p = ray.o;
   int depth = 0;              // surface vertices so far
   bool specular_path = true;  // every bounce so far was specular
@@ -144,7 +143,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     ++acc.work.camera_vertices;
     const VertexGuides guides = tech_.guided ? guiding_.at(si.p, si.ng, bsdf) : VertexGuides{};
     if (!delta) {
-      vertex_techniques(scene, it, {si, bsdf, beta, mis, depth, guided_mis() ? guides : unguided},
+      vertex_techniques(scene, it, {si, bsdf, beta, mis, depth, guided_mis() ? guides : kUnguided},
                         light_path, rng, arena, acc);
       // Importance arriving straight from the lens (directly or through specular bounces only)
       // is what light tracing connects to; a light subpath scattered toward it finds nothing.

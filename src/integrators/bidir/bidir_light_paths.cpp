@@ -174,8 +174,8 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
             pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}));
       }
       if (tech_.light_to_camera)
-        connect_to_camera(scene, it, si, bsdf, guided_mis() ? guides : VertexGuides{}, beta, mis,
-                          depth, rng, chunk);
+        connect_to_camera(scene, it, si, bsdf, guided_mis() ? guides : kUnguided, beta, mis, depth,
+                          rng, chunk);
     }
     if (depth + 1 > max_depth) break;
 

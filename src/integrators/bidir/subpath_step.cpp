@@ -7,8 +7,7 @@ std::optional<SubpathStep> scatter_subpath(const MisRules& rules, MisSums& mis,
                                            const VertexGuides& guides, TransportMode mode,
                                            Pcg32& rng, Rgb& beta, Rgb& rr_beta, bool guided_mis) {
   SubpathStep step;
-  const VertexGuides unguided;
-  const VertexGuides& mis_guides = guided_mis ? guides : unguided;
+  const VertexGuides& mis_guides = guided_mis ? guides : kUnguided;
   if (guides.guide(mode, si.wo)) {
     const float u_technique = rng.next_float(), uc = rng.next_float();
     const auto gs = sample_guided(bsdf, guides, si.wo, mode, u_technique, uc, rng.next_2d());

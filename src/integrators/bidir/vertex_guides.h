@@ -72,6 +72,9 @@ struct VertexGuides {
   }
 };
 
+// No guides: the BSDF's densities alone (never written: guide() returns before any memo).
+inline const VertexGuides kUnguided{};
+
 // The density with which a subpath of `mode` at this vertex samples wi given wo.
 inline float direction_pdf(const Bsdf& bsdf, const VertexGuides& g, Vec3 wo, Vec3 wi,
                            TransportMode mode) {

@@ -380,3 +380,36 @@ TEST(BidirLightSeenDirectly, EmissionPointsConnectedToTheLensConvergeAtOnce) {
   // Without the emission-point connections bpt and vcm would vary as pt does.
   for (const char* name : {"bpt", "vcm"}) EXPECT_LT(spread[name], 0.02 * spread["pt"]) << name;
 }
+
+// The same kind of light, 1.0 x 0.7 (about 56 pixels), behind a surface without a material (a
+// pbrt-v4 "interface"): camera rays pass it, but the emission points' shadow rays stop there. The
+// camera ray must then keep weight 1 (bidir_camera_paths.cpp, through_interface); weighted
+// against connections that cannot happen (about 91% of the weight here) the light went dark.
+TEST(BidirLightSeenDirectly, ThroughAnInterfaceCameraRaysKeepTheLight) {
+  SceneBuilder b;
+  const AreaEmission e{Rgb(100.f), true};
+  b.add_mesh(quad({-0.5f, -0.35f, 5}, {0.5f, -0.35f, 5}, {0.5f, 0.35f, 5}, {-0.5f, 0.35f, 5}),
+             diffuse(Rgb(0.f)), &e);
+  b.add_mesh(quad({-2, -2, 3}, {2, -2, 3}, {2, 2, 3}, {-2, 2, 3}), nullptr);
+  CameraParams c;
+  c.camera_to_world = Transform::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}).inverse();
+  c.width = c.height = 24;
+  c.fov_degrees = 30;
+  b.set_camera(c);
+  auto scene = b.build("light-behind-interface");
+  const double pixels_per_unit = 12.0 / (5.0 * std::tan(15.0 * kPi / 180.0));
+  const double expected = 100.0 * (1.0 * pixels_per_unit) * (0.7 * pixels_per_unit);
+  for (const char* name : {"pt", "bpt", "vcm"}) {
+    IntegratorSettings s;
+    const auto [mean, se] = over_seeds(4, [&](uint64_t seed) {
+      s.seed = seed;
+      const Image img = render_with(*scene, name, 8, s).image;
+      double t = 0;
+      for (size_t i = 0; i < img.pixel_count(); ++i) t += img[i].average();
+      return t;
+    });
+    std::printf("[ light behind an interface ] %-4s image sum %.2f se %.2f (expected %.2f)\n", name,
+                mean, se, expected);
+    EXPECT_NEAR(mean, expected, 3 * se + 5e-3 * expected) << name;
+  }
+}

@@ -341,36 +341,47 @@ TEST(BidirMergingLeaks, NoLightThroughAZeroThicknessWall) {
 
 // --- A small light seen directly ----------------------------------------------------------------
 
-// A 0.10 x 0.07 light facing a pinhole camera 5 units away, nothing else: the image holds only
-// paths of one segment. Its projection is a rectangle of 0.896 x 0.627 pixels (24 pixels over a
-// 30-degree field: 12 / (5 tan 15 deg) pixels per unit), so the image sums to L times 0.5617.
-// A camera ray finds such a light in a few of its samples (pt's total varies by about a third
-// between renders at 16 spp); the bidirectional integrators also connect every light subpath's
-// emission point to the lens (s = 1, t = 1), which the balance heuristic prefers here 1000 to 1.
-TEST(BidirLightSeenDirectly, EmissionPointsConnectedToTheLensConvergeAtOnce) {
+namespace {
+// A two-sided light of radiance 100 on the rectangle [x0, x1] x [y0, y1] at z = 5, facing a
+// pinhole camera at the origin (24 x 24 pixels, 30 degrees): its projection is a rectangle,
+// 12 / (5 tan 15 deg) pixels per unit. With `interface`, a surface without a material lies
+// between them at z = 3.
+constexpr double kPixelsPerUnit = 12.0 / (5.0 * 0.2679491924311227);  // tan 15 deg
+std::unique_ptr<Scene> light_facing_the_lens(float x0, float x1, float y0, float y1,
+                                             bool interface) {
   SceneBuilder b;
   const AreaEmission e{Rgb(100.f), true};
-  const float x0 = 0.03f - 0.05f, x1 = 0.03f + 0.05f, y0 = 0.02f - 0.035f, y1 = 0.02f + 0.035f;
   b.add_mesh(quad({x0, y0, 5}, {x1, y0, 5}, {x1, y1, 5}, {x0, y1, 5}), diffuse(Rgb(0.f)), &e);
+  if (interface) b.add_mesh(quad({-2, -2, 3}, {2, -2, 3}, {2, 2, 3}, {-2, 2, 3}), nullptr);
   CameraParams c;
   c.camera_to_world = Transform::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}).inverse();
   c.width = c.height = 24;
   c.fov_degrees = 30;
   b.set_camera(c);
-  auto scene = b.build("small-light");
-  const double pixels_per_unit = 12.0 / (5.0 * std::tan(15.0 * kPi / 180.0));
-  const double expected = 100.0 * (0.1 * pixels_per_unit) * (0.07 * pixels_per_unit);
-  auto total = [](const Image& img) {
-    double t = 0;
-    for (size_t i = 0; i < img.pixel_count(); ++i) t += img[i].average();
-    return t;
-  };
+  return b.build("light-facing-the-lens");
+}
+double image_sum(const Image& img) {
+  double t = 0;
+  for (size_t i = 0; i < img.pixel_count(); ++i) t += img[i].average();
+  return t;
+}
+}  // namespace
+
+// A 0.10 x 0.07 light 5 units from the pinhole, nothing else: the image holds only paths of one
+// segment and sums to L times 0.896 x 0.627 pixels = 56.1585. A camera ray finds such a light in
+// a few of its samples (pt's total varies by about a third between renders at 16 spp); the
+// bidirectional integrators also connect every light subpath's emission point to the lens
+// (s = 1, t = 1), which the balance heuristic prefers here 1000 to 1.
+TEST(BidirLightSeenDirectly, EmissionPointsConnectedToTheLensConvergeAtOnce) {
+  auto scene =
+      light_facing_the_lens(0.03f - 0.05f, 0.03f + 0.05f, 0.02f - 0.035f, 0.02f + 0.035f, false);
+  const double expected = 100.0 * (0.1 * kPixelsPerUnit) * (0.07 * kPixelsPerUnit);
   std::map<std::string, double> spread;
   for (const char* name : {"pt", "bpt", "vcm", "adaptive-vcm"}) {
     IntegratorSettings s;
     const auto [mean, se] = over_seeds(6, [&](uint64_t seed) {
       s.seed = seed;
-      return total(render_with(*scene, name, 16, s).image);
+      return image_sum(render_with(*scene, name, 16, s).image);
     });
     std::printf("[ small light ] %-12s image sum %.4f se %.4f (expected %.4f)\n", name, mean, se,
                 expected);
@@ -381,32 +392,18 @@ TEST(BidirLightSeenDirectly, EmissionPointsConnectedToTheLensConvergeAtOnce) {
   for (const char* name : {"bpt", "vcm"}) EXPECT_LT(spread[name], 0.02 * spread["pt"]) << name;
 }
 
-// The same kind of light, 1.0 x 0.7 (about 56 pixels), behind a surface without a material (a
-// pbrt-v4 "interface"): camera rays pass it, but the emission points' shadow rays stop there. The
-// camera ray must then keep weight 1 (bidir_camera_paths.cpp, through_interface); weighted
-// against connections that cannot happen (about 91% of the weight here) the light went dark.
+// A 1.0 x 0.7 light (about 56 pixels) behind a surface without a material (a pbrt-v4
+// "interface"): camera rays pass it, but the emission points' shadow rays stop there. The camera
+// ray must then keep weight 1 (bidir_camera_paths.cpp, through_interface); weighted against
+// connections that cannot happen (about 91% of the weight here) the light went dark.
 TEST(BidirLightSeenDirectly, ThroughAnInterfaceCameraRaysKeepTheLight) {
-  SceneBuilder b;
-  const AreaEmission e{Rgb(100.f), true};
-  b.add_mesh(quad({-0.5f, -0.35f, 5}, {0.5f, -0.35f, 5}, {0.5f, 0.35f, 5}, {-0.5f, 0.35f, 5}),
-             diffuse(Rgb(0.f)), &e);
-  b.add_mesh(quad({-2, -2, 3}, {2, -2, 3}, {2, 2, 3}, {-2, 2, 3}), nullptr);
-  CameraParams c;
-  c.camera_to_world = Transform::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}).inverse();
-  c.width = c.height = 24;
-  c.fov_degrees = 30;
-  b.set_camera(c);
-  auto scene = b.build("light-behind-interface");
-  const double pixels_per_unit = 12.0 / (5.0 * std::tan(15.0 * kPi / 180.0));
-  const double expected = 100.0 * (1.0 * pixels_per_unit) * (0.7 * pixels_per_unit);
+  auto scene = light_facing_the_lens(-0.5f, 0.5f, -0.35f, 0.35f, true);
+  const double expected = 100.0 * (1.0 * kPixelsPerUnit) * (0.7 * kPixelsPerUnit);
   for (const char* name : {"pt", "bpt", "vcm"}) {
     IntegratorSettings s;
     const auto [mean, se] = over_seeds(4, [&](uint64_t seed) {
       s.seed = seed;
-      const Image img = render_with(*scene, name, 8, s).image;
-      double t = 0;
-      for (size_t i = 0; i < img.pixel_count(); ++i) t += img[i].average();
-      return t;
+      return image_sum(render_with(*scene, name, 8, s).image);
     });
     std::printf("[ light behind an interface ] %-4s image sum %.2f se %.2f (expected %.2f)\n", name,
                 mean, se, expected);

@@ -289,6 +289,9 @@ std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene, bool guide_cam
   GuidingSettings settings;
   settings.guide_camera_paths = guide_camera;
   settings.guide_light_paths = guide_light;
+  // The radiance is trained on the synthetic photons below (the default learns it from camera
+  // subpaths, which this test does not trace).
+  settings.radiance_records = GuidingSettings::RadianceRecords::Photons;
   settings.spatial_threshold = 200;
   settings.bsdf_fraction = 0.3f;
   g->prepare(scene.bounds(), settings, 6000, 0, 0);  // no budget: it trains forever; 6000 pixels

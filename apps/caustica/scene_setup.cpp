@@ -35,6 +35,10 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
            "Guiding (guided-bpt, guided-vcm): guide both subpaths, or only camera subpaths (by "
            "the radiance learned from light vertices) or only light subpaths (by the importance "
            "learned from camera vertices) (default both)");
+  o.choice("--guiding-radiance", &s->guiding_radiance, {"photons", "camera", "both"},
+           "Guiding (guided-bpt, guided-vcm): what the radiance that guides camera subpaths is "
+           "learned from: the light vertices (photons), the radiance the camera subpaths' own "
+           "vertices received through every technique (as guided-pt), or both (default camera)");
   o.choice("--guiding-mis", &s->guiding_mis, {"mixture", "bsdf"},
            "Guiding (guided-bpt, guided-vcm): MIS weights from the guided mixtures' densities "
            "or from the BSDFs' alone, as unguided bpt/vcm (both unbiased; default bsdf: no guide "
@@ -136,6 +140,10 @@ int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene,
   settings->guiding.guide_camera_paths = s.guiding_subpaths != "light";
   settings->guiding.guide_light_paths = s.guiding_subpaths != "camera";
   settings->guiding.guided_mis = s.guiding_mis == "mixture";
+  using Records = GuidingSettings::RadianceRecords;
+  settings->guiding.radiance_records = s.guiding_radiance == "camera" ? Records::CameraPaths
+                                       : s.guiding_radiance == "both" ? Records::Both
+                                                                      : Records::Photons;
   return 0;
 }
 

@@ -30,6 +30,7 @@ struct SceneSetup {
   std::string guiding_filter = "on";                 // --guiding-filter
   std::string guiding_target = "cosine";             // --guiding-target
   std::string guiding_subpaths = "both";             // --guiding-subpaths
+  std::string guiding_radiance = "camera";           // --guiding-radiance
   std::string guiding_mis = "bsdf";                  // --guiding-mis
   std::string guiding_combine = "inverse-variance";  // --guiding-combine
 };

@@ -72,6 +72,12 @@ class Camera {
   // Densities of a camera ray leaving the lens point p_lens along dir (pbrt-v4 PDF_We): the film
   // test uses the point the ray left from, so thin-lens rays near the border are not lost.
   void pdf_we(Vec3 p_lens, Vec3 dir, float* pdf_pos, float* pdf_dir) const;
+  // pdf_we's direction density for a ray already known to reach the film (the raster position of
+  // a sample_wi): the same value without repeating the film test.
+  float pdf_dir_on_film(Vec3 dir) const {
+    const float cos_theta = dot(dir, forward_);
+    return cos_theta > 0 ? 1.f / (image_plane_area_ * cos_theta * cos_theta * cos_theta) : 0.f;
+  }
   std::optional<CameraWiSample> sample_wi(Vec3 ref, Vec2 u_lens) const;
 
  private:

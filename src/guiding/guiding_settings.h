@@ -41,6 +41,13 @@ struct GuidingSettings {
   // its field is neither learned nor looked up). door-ajar 320x240, 48 spp, 2 threads, relMSE
   // per sample: camera 0.86, light 1.04, both 0.80 (vcm 1.04).
   bool guide_camera_paths = true, guide_light_paths = true;
+  // guided-bpt / guided-vcm: what the radiance field (which guides camera subpaths) learns from:
+  // the light vertices (photons: the flux arriving at each, Vorba et al. 2014), the camera
+  // subpaths themselves (the radiance each guided camera vertex received along its sampled
+  // direction through every later technique, over that direction's density: Mueller et al.
+  // 2017's records, as guided-pt's), or both.
+  enum class RadianceRecords : uint8_t { Photons, CameraPaths, Both };
+  RadianceRecords radiance_records = RadianceRecords::CameraPaths;
   // guided-bpt / guided-vcm: the MIS weights use the guided mixtures' densities, forward and
   // reverse (Vorba et al. 2014), or the BSDFs' alone, as unguided bpt/vcm would (the default).
   // Either is a partition of unity (every technique's weight comes from the same densities), so

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "integrators/bidir/bidir_core.h"
+#include "integrators/bidir/camera_radiance_records.h"
 #include "integrators/bidir/subpath_step.h"
 #include "integrators/path_vertex.h"
 #include "lights/light.h"
@@ -93,6 +94,10 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   // area light seen straight from the lens is weighted against the light subpaths' emission
   // points connected to the lens, unless the ray passed an interface (that connection's shadow
   // ray stops there).
+  // guided-bpt / guided-vcm learning radiance from camera subpaths: this pixel's records.
+  std::optional<CameraRadianceRecords> radiance_records;
+  if (tech_.guided && guiding_.records_radiance_pixel(pixel))
+    radiance_records.emplace(arena, max_depth);
   TechniqueTerms terms;
   bool weighted = false;  // the last emitter weight came from terms
   auto emitter_weight = [&](const Light& light, const SurfaceInteraction* hit, const MisSums& m) {
@@ -154,6 +159,11 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     const auto step = scatter_subpath(rules, mis, si, bsdf, guides, TransportMode::Radiance, rng,
                                       beta, rr_beta, guided_mis());
     if (!step) break;
+    if (radiance_records && !step->specular && BidirGuiding::guidable(bsdf)) {
+      radiance_records->gained(acc.sum);  // what this vertex's techniques found is not its own
+      radiance_records->add({si.p, si.ng, step->wi, depth, bsdf.abs_cos(step->wi) / step->pdf,
+                             step->weight, step->bsdf_pdf, step->guide_pdf, beta, Rgb(0.f)});
+    }
     // PPM / lt: the non-delta part of this vertex was estimated by merging (or belongs to light
     // tracing); only its delta lobes carry the camera path on.
     if (tech_.camera_stops && !delta && !step->specular) break;
@@ -166,6 +176,11 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
                      : !survives_russian_roulette(beta, eta_scale, depth, rng))
       break;
   }
+  if (radiance_records)
+    radiance_records->finish(
+        acc.sum, [&](const CameraRadianceRecords::Vertex& v, float radiance, float product) {
+          guiding_.record_camera_radiance(pixel, v, radiance, product);
+        });
 }
 
 void BidirIntegrator::vertex_techniques(const Scene& scene, const Iteration& it,

@@ -21,12 +21,18 @@ constexpr float kDefaultBsdfFraction = 0.5f;
 void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint64_t pixels,
                            int spp, double seconds) {
   enabled_ = true;
-  if (settings.bsdf_fraction < 0) settings.bsdf_fraction = kDefaultBsdfFraction;
   guide_camera_ = settings.guide_camera_paths;
   guide_light_ = settings.guide_light_paths;
+  using Records = GuidingSettings::RadianceRecords;
+  radiance_from_photons_ = settings.radiance_records != Records::CameraPaths;
+  radiance_from_camera_ = settings.radiance_records != Records::Photons;
   if (guide_camera_ && guide_light_) settings.max_bytes /= 2;
-  radiance_ = GuidingField(bounds, settings, /*sided=*/true);
-  importance_ = GuidingField(bounds, settings, /*sided=*/true);
+  // The BSDF selection probability is learned (negative) only from the camera subpaths'
+  // records, which carry the product f |cos| L_i; photons and importance records do not.
+  GuidingSettings fixed = settings;
+  if (fixed.bsdf_fraction < 0) fixed.bsdf_fraction = kDefaultBsdfFraction;
+  radiance_ = GuidingField(bounds, radiance_from_camera_ ? settings : fixed, /*sided=*/true);
+  importance_ = GuidingField(bounds, fixed, /*sided=*/true);
   schedule_ = TrainingSchedule(spp, seconds);
   iteration_ = 0;
   // About four camera vertices per path: one pixel in k keeps the records under kMaxRecords.
@@ -38,7 +44,11 @@ void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint
 void BidirGuiding::begin_iteration(uint32_t iteration, double elapsed) {
   iteration_ = iteration;
   if (iteration == 0) schedule_.starts_pass(0, elapsed);
-  if (schedule_.learning()) camera_records_.begin_iteration(pixels_ / camera_stride_ + 1);
+  if (schedule_.learning()) {
+    camera_records_.begin_iteration(pixels_ / camera_stride_ + 1);
+    if (radiance_from_camera_)
+      camera_radiance_records_.begin_iteration(pixels_ / camera_stride_ + 1);
+  }
 }
 
 bool BidirGuiding::end_pass_after(uint32_t iteration, double elapsed,
@@ -55,11 +65,13 @@ bool BidirGuiding::end_pass_after(uint32_t iteration, double elapsed,
   return true;
 }
 
+bool BidirGuiding::guidable(const Bsdf& bsdf) {
+  return !is_specular(bsdf.flags()) && !bsdf.is_delta() && !bsdf.stochastic();
+}
+
 VertexGuides BidirGuiding::at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const {
   VertexGuides g;
-  if (!enabled_ || !schedule_.guided() || is_specular(bsdf.flags()) || bsdf.is_delta() ||
-      bsdf.stochastic())
-    return g;
+  if (!enabled_ || !schedule_.guided() || !guidable(bsdf)) return g;
   g.fields = this;
   g.p = p;
   g.n = ng;
@@ -114,6 +126,18 @@ void BidirGuiding::record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 
                       value * float(camera_stride_)));
 }
 
+void BidirGuiding::record_camera_radiance(uint64_t pixel, const CameraRadianceRecords::Vertex& v,
+                                          float radiance, float product) const {
+  const float stride = float(camera_stride_);
+  GuidingRecord r = record_at(radiance_, pixel * kKeysPerPixel + uint64_t(v.depth), v.p, v.ng, v.wi,
+                              radiance * stride);
+  // The BSDF selection learns where a guide sampled (guide_pdf > 0) and something was found.
+  r.product = product * stride;
+  r.bsdf_pdf = v.bsdf_pdf;
+  r.guide_pdf = v.guide_pdf;
+  camera_radiance_records_.writer(pixel / camera_stride_).push(r);
+}
+
 void BidirGuiding::learn(GuidingField& field, std::span<const std::span<const GuidingRecord>> runs,
                          uint64_t stride) {
   // Every record stands for `stride` vertices in the split rule's counts (and its value was
@@ -133,6 +157,11 @@ void BidirGuiding::end_iteration(const Scene& scene,
     learn(importance_, camera_records_.runs(), camera_stride_);
   }
   if (!guide_camera_) return;
+  if (radiance_from_camera_) {
+    radiance_records_ += camera_radiance_records_.size();
+    learn(radiance_, camera_radiance_records_.runs(), camera_stride_);
+  }
+  if (!radiance_from_photons_) return;
   // Radiance from the light vertices: every k-th one, shifted by the iteration.
   const size_t n = light_vertices.size();
   const size_t stride = std::max<size_t>(1, (n + kMaxRecords - 1) / kMaxRecords);
@@ -177,8 +206,12 @@ void BidirGuiding::report(nlohmann::json& stats) const {
                          : guide_camera_               ? "camera"
                                                        : "light";
   g["radiance_records"] = radiance_records_;
+  g["radiance_learned_from"] = radiance_from_photons_ && radiance_from_camera_ ? "both"
+                               : radiance_from_camera_                         ? "camera"
+                                                                               : "photons";
   g["importance_records"] = importance_records_;
-  g["bsdf_fraction"] = radiance_.settings().bsdf_fraction;
+  g["bsdf_fraction"] = importance_.settings().bsdf_fraction;
+  g["radiance_bsdf_fraction_mean"] = radiance_.mean_bsdf_fraction();
   if (!views_.is_null()) g["views"] = views_;
   stats["guiding"] = g;
 }

@@ -48,6 +48,7 @@
 #include "guiding/pixel_records.h"
 #include "guiding/training_schedule.h"
 #include "image/inverse_variance.h"
+#include "integrators/bidir/camera_radiance_records.h"
 #include "integrators/bidir/light_vertex.h"
 #include "integrators/bidir/vertex_guides.h"
 
@@ -81,6 +82,9 @@ class BidirGuiding {
   // The guides at a vertex at p with geometric normal ng and this BSDF (empty where it is not
   // guided).
   VertexGuides at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const;
+  // Whether a vertex with this BSDF is guided once its leaf has learned (no delta, near-specular
+  // or stochastic lobes: those sample the BSDF alone, as in guided-pt).
+  static bool guidable(const Bsdf& bsdf);
 
   // Camera vertices of `pixel` are recorded this iteration (one pixel in k, while training).
   bool records_pixel(uint64_t pixel) const {
@@ -89,6 +93,16 @@ class BidirGuiding {
   // The camera subpath of `pixel` reached a non-delta vertex at p (geometric normal ng),
   // arriving along -wo with throughput beta (from estimate(): any thread).
   void record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 ng, Vec3 wo, Rgb beta) const;
+  // The radiance field learns from the camera subpaths of `pixel` this iteration
+  // (GuidingSettings::RadianceRecords; the same pixels as record_camera_vertex's).
+  bool records_radiance_pixel(uint64_t pixel) const {
+    return guide_camera_ && radiance_from_camera_ && schedule_.learning() &&
+           (pixel + iteration_) % camera_stride_ == 0;
+  }
+  // A camera vertex of `pixel` received `radiance` along its wi, with `product` for the BSDF
+  // selection (camera_radiance_records.h).
+  void record_camera_radiance(uint64_t pixel, const CameraRadianceRecords::Vertex& v,
+                              float radiance, float product) const;
   // After the camera pass: learns from this iteration's light vertices (their normals from the
   // scene) and camera records (training passes only).
   void end_iteration(const Scene& scene, const std::vector<LightVertex>& light_vertices);
@@ -110,14 +124,16 @@ class BidirGuiding {
 
   bool enabled_ = false;
   bool guide_camera_ = true, guide_light_ = true;  // GuidingSettings::guide_*_paths
+  bool radiance_from_photons_ = true, radiance_from_camera_ = false;  // ::radiance_records
   GuidingField radiance_, importance_;
   TrainingSchedule schedule_;
   uint32_t iteration_ = 0;
   uint64_t camera_stride_ = 1;
   uint64_t radiance_records_ = 0, importance_records_ = 0;
   uint64_t pixels_ = 0;
-  PixelRecords camera_records_;        // slot: pixel / camera_stride_
-  std::vector<GuidingRecord> merged_;  // the light vertices' records, in their order
+  PixelRecords camera_records_;           // slot: pixel / camera_stride_
+  PixelRecords camera_radiance_records_;  // the same slots
+  std::vector<GuidingRecord> merged_;     // the light vertices' records, in their order
   nlohmann::json views_;
 };
 

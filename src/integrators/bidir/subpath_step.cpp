@@ -14,6 +14,10 @@ std::optional<SubpathStep> scatter_subpath(const MisRules& rules, MisSums& mis,
     if (!gs) return std::nullopt;
     step.wi = gs->wi;
     step.eta = gs->eta;
+    step.pdf = gs->pdf;
+    step.bsdf_pdf = gs->bsdf_pdf;
+    step.guide_pdf = gs->guide_pdf;
+    step.weight = gs->weight;
     scatter_update(rules, mis, si, bsdf, si.wo, step.wi, mode, false,
                    guided_mis ? gs->pdf : gs->bsdf_pdf, mis_guides);
     beta *= gs->weight;
@@ -30,6 +34,9 @@ std::optional<SubpathStep> scatter_subpath(const MisRules& rules, MisSums& mis,
       bs->pdf_is_proportional ? direction_pdf(bsdf, mis_guides, si.wo, step.wi, mode) : bs->pdf;
   scatter_update(rules, mis, si, bsdf, si.wo, step.wi, mode, step.specular, pdf_fwd, mis_guides);
   const Rgb weight = bs->f * (bsdf.abs_cos(step.wi) / bs->pdf);
+  step.pdf = bs->pdf;
+  step.bsdf_pdf = bs->pdf;
+  step.weight = weight;
   beta *= weight;
   rr_beta *= weight;
   return step;

@@ -15,6 +15,10 @@ struct SubpathStep {
   Vec3 wi;
   bool specular = false;  // a delta lobe was sampled
   float eta = 1;          // of a sampled refraction, else 1
+  float pdf = 0;          // the density wi was sampled with (the mixture's where guided)
+  float bsdf_pdf = 0;     // the BSDF's density of wi
+  float guide_pdf = 0;    // the learned distribution's density of wi (0: not guided)
+  Rgb weight;             // f |cos| / pdf
 };
 
 // beta *= f |cos| / pdf; rr_beta *= f |cos| / p_bsdf (what BSDF sampling alone would give, for

@@ -115,9 +115,8 @@ LensConnection lens_connection_of_emission(const Camera& camera, Vec3 p, Vec3 n,
   LensConnection c;
   c.dist2 = length_squared(d);
   const Vec3 dir = d / std::sqrt(c.dist2);
-  float pdf_pos, pdf_dir;
-  camera.pdf_we(p_lens, -dir, &pdf_pos, &pdf_dir);
-  c.pixels_pdf_dir = float(camera.pixel_count()) * pdf_dir;
+  // The lens point came from sample_wi, whose ray reached the film: no second film test.
+  c.pixels_pdf_dir = float(camera.pixel_count()) * camera.pdf_dir_on_film(-dir);
   c.cos_at_vertex = abs_dot(n, dir);
   return c;
 }

@@ -78,7 +78,8 @@ TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera
                                      const MisSums& light, Vec3 p_lens, float raster_density = 1.f,
                                      const VertexGuides& guides = {});
 // An area light's emission point p (geometric normal n) connected to the lens point p_lens
-// (s = 1, t = 1); emission_pos_pdf = pmf * pdf_pos. The connection's rev is unused.
+// (s = 1, t = 1); emission_pos_pdf = pmf * pdf_pos. The connection's rev is unused. Both
+// lens_connection functions take p_lens from a sample_wi that reached the film (no film test).
 LensConnection lens_connection_of_emission(const Camera& camera, Vec3 p, Vec3 n, Vec3 p_lens);
 TechniqueTerms terms_light_origin_to_camera(const MisRules& rules, const LensConnection& c,
                                             float emission_pos_pdf, float raster_density = 1.f);

@@ -87,11 +87,12 @@ inline float direction_pdf(const Bsdf& bsdf, const VertexGuides& g, Vec3 wo, Vec
 // A direction sampled from the mixture of `mode` at a vertex with a guide for it.
 struct GuidedSample {
   Vec3 wi;
-  float pdf = 0;       // the mixture's
-  float bsdf_pdf = 0;  // the BSDF's alone
-  Rgb weight;          // f |cos| / pdf
-  Rgb bsdf_weight;     // f |cos| / p_bsdf: the weight had the BSDF alone been sampled (roulette)
-  float eta = 1;       // of a sampled refraction, else 1
+  float pdf = 0;        // the mixture's
+  float bsdf_pdf = 0;   // the BSDF's alone
+  float guide_pdf = 0;  // the learned distribution's alone
+  Rgb weight;           // f |cos| / pdf
+  Rgb bsdf_weight;      // f |cos| / p_bsdf: the weight had the BSDF alone been sampled (roulette)
+  float eta = 1;        // of a sampled refraction, else 1
 };
 
 // u_technique picks the BSDF (below the BSDF fraction) or the guide; uc and u sample either.
@@ -112,7 +113,8 @@ inline std::optional<GuidedSample> sample_guided(const Bsdf& bsdf, const VertexG
   }
   const float bsdf_pdf = bsdf.pdf(wo, s.wi, mode);
   s.bsdf_pdf = bsdf_pdf;
-  s.pdf = a * bsdf_pdf + (1 - a) * g.guide_pdf(mode, wo, s.wi);
+  s.guide_pdf = g.guide_pdf(mode, wo, s.wi);
+  s.pdf = a * bsdf_pdf + (1 - a) * s.guide_pdf;
   if (!(s.pdf > 0)) return std::nullopt;
   const Rgb f_cos = bsdf.f(wo, s.wi, mode) * bsdf.abs_cos(s.wi);
   if (f_cos.is_black()) return std::nullopt;

@@ -289,9 +289,10 @@ std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene, bool guide_cam
   GuidingSettings settings;
   settings.guide_camera_paths = guide_camera;
   settings.guide_light_paths = guide_light;
-  // The radiance is trained on the synthetic photons below (the default learns it from camera
-  // subpaths, which this test does not trace).
+  // The fields are trained on the synthetic photons and importons below (the defaults learn
+  // them from the subpaths' own vertices, which this test does not trace).
   settings.radiance_records = GuidingSettings::RadianceRecords::Photons;
+  settings.importance_records = GuidingSettings::ImportanceRecords::Importons;
   settings.spatial_threshold = 200;
   settings.bsdf_fraction = 0.3f;
   g->prepare(scene.bounds(), settings, 6000, 0, 0);  // no budget: it trains forever; 6000 pixels

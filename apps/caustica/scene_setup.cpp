@@ -39,6 +39,10 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
            "Guiding (guided-bpt, guided-vcm): what the radiance that guides camera subpaths is "
            "learned from: the light vertices (photons), the radiance the camera subpaths' own "
            "vertices received through every technique (as guided-pt), or both (default camera)");
+  o.choice("--guiding-importance", &s->guiding_importance, {"importons", "light", "both"},
+           "Guiding (guided-bpt, guided-vcm): what the importance that guides light subpaths is "
+           "learned from: the camera vertices (importons), what the light subpaths' own later "
+           "vertices saw of the lens, or both (default light)");
   o.choice("--guiding-mis", &s->guiding_mis, {"mixture", "bsdf"},
            "Guiding (guided-bpt, guided-vcm): MIS weights from the guided mixtures' densities "
            "or from the BSDFs' alone, as unguided bpt/vcm (both unbiased; default bsdf: no guide "
@@ -144,6 +148,10 @@ int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene,
   settings->guiding.radiance_records = s.guiding_radiance == "camera" ? Records::CameraPaths
                                        : s.guiding_radiance == "both" ? Records::Both
                                                                       : Records::Photons;
+  using Importance = GuidingSettings::ImportanceRecords;
+  settings->guiding.importance_records = s.guiding_importance == "light"  ? Importance::LightPaths
+                                         : s.guiding_importance == "both" ? Importance::Both
+                                                                          : Importance::Importons;
   return 0;
 }
 

@@ -31,6 +31,7 @@ struct SceneSetup {
   std::string guiding_target = "cosine";             // --guiding-target
   std::string guiding_subpaths = "both";             // --guiding-subpaths
   std::string guiding_radiance = "camera";           // --guiding-radiance
+  std::string guiding_importance = "light";          // --guiding-importance
   std::string guiding_mis = "bsdf";                  // --guiding-mis
   std::string guiding_combine = "inverse-variance";  // --guiding-combine
 };

@@ -48,6 +48,12 @@ struct GuidingSettings {
   // 2017's records, as guided-pt's), or both.
   enum class RadianceRecords : uint8_t { Photons, CameraPaths, Both };
   RadianceRecords radiance_records = RadianceRecords::CameraPaths;
+  // The converse for the importance field (which guides light subpaths): the camera vertices
+  // (importons: the importance arriving at each, Vorba et al. 2014), the light subpaths
+  // themselves (the importance each guided light vertex received along its sampled direction:
+  // what its later vertices' connections to the lens found, unweighted), or both.
+  enum class ImportanceRecords : uint8_t { Importons, LightPaths, Both };
+  ImportanceRecords importance_records = ImportanceRecords::LightPaths;
   // guided-bpt / guided-vcm: the MIS weights use the guided mixtures' densities, forward and
   // reverse (Vorba et al. 2014), or the BSDFs' alone, as unguided bpt/vcm would (the default).
   // Either is a partition of unity (every technique's weight comes from the same densities), so

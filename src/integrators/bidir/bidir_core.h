@@ -212,10 +212,12 @@ class BidirIntegrator final : public CameraPathIntegrator {
                              uint32_t technique, const ValueOf& value_of, const TermsOf& terms_of,
                              LightChunk& chunk) const;
   static void drop_splats_from(size_t first, LightChunk& chunk);
-  // t = 1: the light vertex seen through a lens point; splat recorded in the chunk.
-  void connect_to_camera(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
-                         const Bsdf& bsdf, const VertexGuides& guides, Rgb beta, const MisSums& mis,
-                         int depth, Pcg32& rng, LightChunk& chunk) const;
+  // t = 1: the light vertex seen through a lens point; splat recorded in the chunk. Returns
+  // the connection's unweighted estimate (0 when blocked), what the guiding of light subpaths
+  // learns from.
+  Rgb connect_to_camera(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
+                        const Bsdf& bsdf, const VertexGuides& guides, Rgb beta, const MisSums& mis,
+                        int depth, Pcg32& rng, LightChunk& chunk) const;
 
   // ---- camera subpaths ----------------------------------------------------------------------
   // The seam's per-pixel call: the camera subpath of this iteration (current_).

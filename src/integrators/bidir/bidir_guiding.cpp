@@ -26,13 +26,16 @@ void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint
   using Records = GuidingSettings::RadianceRecords;
   radiance_from_photons_ = settings.radiance_records != Records::CameraPaths;
   radiance_from_camera_ = settings.radiance_records != Records::Photons;
+  using Importance = GuidingSettings::ImportanceRecords;
+  importance_from_camera_ = settings.importance_records != Importance::LightPaths;
+  importance_from_light_ = settings.importance_records != Importance::Importons;
   if (guide_camera_ && guide_light_) settings.max_bytes /= 2;
   // The BSDF selection probability is learned (negative) only from the camera subpaths'
   // records, which carry the product f |cos| L_i; photons and importance records do not.
   GuidingSettings fixed = settings;
   if (fixed.bsdf_fraction < 0) fixed.bsdf_fraction = kDefaultBsdfFraction;
   radiance_ = GuidingField(bounds, radiance_from_camera_ ? settings : fixed, /*sided=*/true);
-  importance_ = GuidingField(bounds, fixed, /*sided=*/true);
+  importance_ = GuidingField(bounds, importance_from_light_ ? settings : fixed, /*sided=*/true);
   schedule_ = TrainingSchedule(spp, seconds);
   iteration_ = 0;
   // About four camera vertices per path: one pixel in k keeps the records under kMaxRecords.
@@ -41,9 +44,14 @@ void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint
   radiance_records_ = importance_records_ = 0;
 }
 
-void BidirGuiding::begin_iteration(uint32_t iteration, double elapsed) {
+void BidirGuiding::begin_iteration(uint32_t iteration, double elapsed, uint64_t light_paths) {
   iteration_ = iteration;
   if (iteration == 0) schedule_.starts_pass(0, elapsed);
+  if (light_paths == 0) light_paths = pixels_;
+  // About three guided vertices per light subpath.
+  light_stride_ = std::max<uint64_t>(1, (3 * light_paths + kMaxRecords - 1) / kMaxRecords);
+  if (schedule_.learning() && importance_from_light_)
+    light_records_.begin_iteration(light_paths / light_stride_ + 1);
   if (schedule_.learning()) {
     camera_records_.begin_iteration(pixels_ / camera_stride_ + 1);
     if (radiance_from_camera_)
@@ -78,23 +86,18 @@ VertexGuides BidirGuiding::at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const {
   return g;
 }
 
-void VertexGuides::resolve(int side) const {
+void VertexGuides::resolve(TransportMode mode, int side) const {
   const int front = GuidingField::side_class(n);
   const int c = side ? front ^ 1 : front;  // -n: the same axis, the other sign
   // A subpath that is not guided keeps no guide (its densities are the BSDF's).
-  if (fields->guide_camera_) {
-    const GuidingField& radiance = fields->radiance_;
-    const GuidingField::Guide& r = radiance.guide(radiance.leaf_at(p, c));
-    guides[int(TransportMode::Radiance)][side] = r.distribution;
-    bsdf[int(TransportMode::Radiance)][side] = r.bsdf_fraction;
+  const bool radiance = mode == TransportMode::Radiance;
+  if (radiance ? fields->guide_camera_ : fields->guide_light_) {
+    const GuidingField& field = radiance ? fields->radiance_ : fields->importance_;
+    const GuidingField::Guide& g = field.guide(field.leaf_at(p, c));
+    guides[int(mode)][side] = g.distribution;
+    bsdf[int(mode)][side] = g.bsdf_fraction;
   }
-  if (fields->guide_light_) {
-    const GuidingField& importance = fields->importance_;
-    const GuidingField::Guide& i = importance.guide(importance.leaf_at(p, c));
-    guides[int(TransportMode::Importance)][side] = i.distribution;
-    bsdf[int(TransportMode::Importance)][side] = i.bsdf_fraction;
-  }
-  resolved |= uint8_t(1u << side);
+  resolved |= uint8_t(1u << (2 * int(mode) + side));
 }
 
 GuidingRecord BidirGuiding::record_at(const GuidingField& field, uint64_t key, Vec3 p, Vec3 ng,
@@ -138,6 +141,17 @@ void BidirGuiding::record_camera_radiance(uint64_t pixel, const CameraRadianceRe
   camera_radiance_records_.writer(pixel / camera_stride_).push(r);
 }
 
+void BidirGuiding::record_light_importance(uint64_t path, const CameraRadianceRecords::Vertex& v,
+                                           float importance, float product) const {
+  const float stride = float(light_stride_);
+  GuidingRecord r = record_at(importance_, path * kKeysPerPixel + uint64_t(v.depth), v.p, v.ng,
+                              v.wi, importance * stride);
+  r.product = product * stride;
+  r.bsdf_pdf = v.bsdf_pdf;
+  r.guide_pdf = v.guide_pdf;
+  light_records_.writer(path / light_stride_).push(r);
+}
+
 void BidirGuiding::learn(GuidingField& field, std::span<const std::span<const GuidingRecord>> runs,
                          uint64_t stride) {
   // Every record stands for `stride` vertices in the split rule's counts (and its value was
@@ -152,7 +166,11 @@ void BidirGuiding::learn(GuidingField& field, std::span<const std::span<const Gu
 void BidirGuiding::end_iteration(const Scene& scene,
                                  const std::vector<LightVertex>& light_vertices) {
   if (!schedule_.learning()) return;
-  if (guide_light_) {
+  if (guide_light_ && importance_from_light_) {
+    importance_records_ += light_records_.size();
+    learn(importance_, light_records_.runs(), light_stride_);
+  }
+  if (guide_light_ && importance_from_camera_) {
     importance_records_ += camera_records_.size();
     learn(importance_, camera_records_.runs(), camera_stride_);
   }
@@ -212,6 +230,10 @@ void BidirGuiding::report(nlohmann::json& stats) const {
   g["importance_records"] = importance_records_;
   g["bsdf_fraction"] = importance_.settings().bsdf_fraction;
   g["radiance_bsdf_fraction_mean"] = radiance_.mean_bsdf_fraction();
+  g["importance_bsdf_fraction_mean"] = importance_.mean_bsdf_fraction();
+  g["importance_learned_from"] = importance_from_light_ && importance_from_camera_ ? "both"
+                                 : importance_from_light_                          ? "light"
+                                                                                   : "importons";
   if (!views_.is_null()) g["views"] = views_;
   stats["guiding"] = g;
 }

@@ -69,7 +69,8 @@ class BidirGuiding {
   bool enabled() const { return enabled_; }
 
   // Before iteration i, `elapsed` seconds into the render.
-  void begin_iteration(uint32_t iteration, double elapsed);
+  // light_paths: the iteration's light subpaths (0: as many as pixels).
+  void begin_iteration(uint32_t iteration, double elapsed, uint64_t light_paths = 0);
   // After iteration i and its pixel moments in `passes`: when the next iteration starts a new
   // pass, the schedule weighs the pass that ended (its variance: the last of `passes`), its
   // fields learn what it recorded, and true is returned (the caller then ends the pass in
@@ -88,8 +89,17 @@ class BidirGuiding {
 
   // Camera vertices of `pixel` are recorded this iteration (one pixel in k, while training).
   bool records_pixel(uint64_t pixel) const {
-    return guide_light_ && schedule_.learning() && (pixel + iteration_) % camera_stride_ == 0;
+    return guide_light_ && importance_from_camera_ && schedule_.learning() &&
+           (pixel + iteration_) % camera_stride_ == 0;
   }
+  // The importance field learns from light subpath `path` this iteration.
+  bool records_importance_path(uint64_t path) const {
+    return guide_light_ && importance_from_light_ && schedule_.learning() &&
+           (path + iteration_) % light_stride_ == 0;
+  }
+  // A light vertex of `path` received `importance` along its wi (camera_radiance_records.h).
+  void record_light_importance(uint64_t path, const CameraRadianceRecords::Vertex& v,
+                               float importance, float product) const;
   // The camera subpath of `pixel` reached a non-delta vertex at p (geometric normal ng),
   // arriving along -wo with throughput beta (from estimate(): any thread).
   void record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 ng, Vec3 wo, Rgb beta) const;
@@ -124,7 +134,9 @@ class BidirGuiding {
 
   bool enabled_ = false;
   bool guide_camera_ = true, guide_light_ = true;  // GuidingSettings::guide_*_paths
-  bool radiance_from_photons_ = true, radiance_from_camera_ = false;  // ::radiance_records
+  bool radiance_from_photons_ = true, radiance_from_camera_ = false;    // ::radiance_records
+  bool importance_from_camera_ = true, importance_from_light_ = false;  // ::importance_records
+  uint64_t light_stride_ = 1;
   GuidingField radiance_, importance_;
   TrainingSchedule schedule_;
   uint32_t iteration_ = 0;
@@ -133,6 +145,7 @@ class BidirGuiding {
   uint64_t pixels_ = 0;
   PixelRecords camera_records_;           // slot: pixel / camera_stride_
   PixelRecords camera_radiance_records_;  // the same slots
+  PixelRecords light_records_;            // slot: light path / light_stride_
   std::vector<GuidingRecord> merged_;     // the light vertices' records, in their order
   nlohmann::json views_;
 };

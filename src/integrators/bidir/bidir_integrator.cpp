@@ -120,7 +120,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   it.merge_normalization = n ? 1.f / (kPi * it.radius * it.radius * float(n)) : 0.f;
   it.light_path_of =
       LightPathAssignment(film.pixel_count(), std::max<uint64_t>(n, 1), iteration, settings_.seed);
-  if (tech_.guided) guiding_.begin_iteration(iteration, seconds_since(start_));
+  if (tech_.guided) guiding_.begin_iteration(iteration, seconds_since(start_), n);
   probe_ = {};
   probe_.light_paths = double(n);
   if (it.plan.probe) plan_.begin_probe(it.radius);

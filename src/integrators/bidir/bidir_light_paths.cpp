@@ -10,6 +10,7 @@
 
 #include "film/film.h"
 #include "integrators/bidir/bidir_core.h"
+#include "integrators/bidir/camera_radiance_records.h"
 #include "integrators/bidir/subpath_step.h"
 #include "lights/light.h"
 #include "lights/light_sampler.h"
@@ -145,6 +146,12 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
   const int max_depth = settings_.max_depth;
 
   Ray ray = ray_leaving_light(*le, *light);
+  // guided-bpt / guided-vcm learning importance from light subpaths: what each guided vertex's
+  // later vertices saw of the camera (camera_radiance_records.h, with importance).
+  std::optional<CameraRadianceRecords> importance_records;
+  if (tech_.guided && guiding_.records_importance_path(path))
+    importance_records.emplace(arena, max_depth);
+  Rgb seen(0.f);  // the unweighted lens connections so far
   MisSums mis;
   float segment = 0;  // distance since the previous real vertex (interfaces are skipped)
   int depth = 0;
@@ -173,15 +180,22 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
         chunk.vertices.push_back(
             pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}));
       }
-      if (tech_.light_to_camera)
-        connect_to_camera(scene, it, si, bsdf, guided_mis() ? guides : kUnguided, beta, mis, depth,
-                          rng, chunk);
+      if (tech_.light_to_camera) {
+        const Rgb c = connect_to_camera(scene, it, si, bsdf, guided_mis() ? guides : kUnguided,
+                                        beta, mis, depth, rng, chunk);
+        if (c.is_finite()) seen += c;
+      }
     }
     if (depth + 1 > max_depth) break;
 
     const auto step = scatter_subpath(it.rules, mis, si, bsdf, guides, TransportMode::Importance,
                                       rng, beta, rr_beta, guided_mis());
     if (!step) break;
+    if (importance_records && !step->specular && BidirGuiding::guidable(bsdf)) {
+      importance_records->gained(seen);
+      importance_records->add({si.p, si.ng, step->wi, depth, bsdf.abs_cos(step->wi) / step->pdf,
+                               step->weight, step->bsdf_pdf, step->guide_pdf, beta, Rgb(0.f)});
+    }
     if (beta.is_black()) break;
     ray = si.spawn_ray(step->wi);
     // Russian roulette on the throughput relative to the emitted one (importance carries no
@@ -197,6 +211,11 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
       rr_beta = rr_beta / (1 - q);
     }
   }
+  if (importance_records)
+    importance_records->finish(
+        seen, [&](const CameraRadianceRecords::Vertex& v, float importance, float product) {
+          guiding_.record_light_importance(path, v, importance, product);
+        });
 }
 
 template <typename ValueOf, typename TermsOf>
@@ -259,15 +278,15 @@ void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Itera
   if (scene.occluded({o, cs->p_lens - o, 1.f - 1e-4f})) drop_splats_from(first_splat, chunk);
 }
 
-void BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
-                                        const SurfaceInteraction& si, const Bsdf& bsdf,
-                                        const VertexGuides& guides, Rgb beta, const MisSums& mis,
-                                        int depth, Pcg32& rng, LightChunk& chunk) const {
+Rgb BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
+                                       const SurfaceInteraction& si, const Bsdf& bsdf,
+                                       const VertexGuides& guides, Rgb beta, const MisSums& mis,
+                                       int depth, Pcg32& rng, LightChunk& chunk) const {
   const Camera& camera = scene.camera();
   const auto cs = camera.sample_wi(si.p, rng.next_2d());
-  if (!cs || !(cs->importance > 0)) return;
+  if (!cs || !(cs->importance > 0)) return Rgb(0.f);
   const Rgb f = bsdf.f(si.wo, cs->wi, TransportMode::Importance) * bsdf.abs_cos(cs->wi);
-  if (f.is_black()) return;
+  if (f.is_black()) return Rgb(0.f);
   // Pixel importance is pixel_count * We * f(r - c_p) / integral f; each pixel is estimated by
   // N light paths. Every pixel whose filter support holds the raster point r gets a splat,
   // MIS-weighted against its own camera technique (raster density pdf(r - c_p)).
@@ -282,7 +301,12 @@ void BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
         return terms_light_to_camera(rules, lens, mis, raster_density);
       },
       chunk);
-  if (splatted && scene.occluded(si.spawn_ray_to(cs->p_lens))) drop_splats_from(first_splat, chunk);
+  if (!splatted) return Rgb(0.f);
+  if (scene.occluded(si.spawn_ray_to(cs->p_lens))) {
+    drop_splats_from(first_splat, chunk);
+    return Rgb(0.f);
+  }
+  return beta * f * scale;
 }
 
 }  // namespace caustica::bidir

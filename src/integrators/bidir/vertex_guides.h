@@ -26,15 +26,16 @@ namespace caustica::bidir {
 
 class BidirGuiding;
 
-// A side's guides are looked up in the learned fields the first time a density asks for them
-// (most vertices only ever need the side their subpaths arrive on).
+// A (mode, side)'s guide is looked up in its learned field the first time a density asks for it
+// (most vertices only ever need one: the mode of their subpath, on the side it arrives from;
+// looking up both fields at once was twice the spatial descents).
 struct VertexGuides {
   const BidirGuiding* fields = nullptr;  // nullptr: not guided (the BSDF alone)
   Vec3 p;
   Vec3 n;  // the geometric normal: the side a direction lies on
   // guides[mode][side]: what a subpath of `mode` that arrived from `side` (0: the side n points
   // to) samples from, nullptr where nothing was learned; bsdf[mode][side]: the probability of
-  // sampling the BSDF instead. Filled for a side once resolved has its bit.
+  // sampling the BSDF instead. Filled for (mode, side) once resolved has bit 2 mode + side.
   mutable const DirectionalQuadtree* guides[2][2] = {{nullptr, nullptr}, {nullptr, nullptr}};
   mutable float bsdf[2][2] = {{1, 1}, {1, 1}};
   mutable uint8_t resolved = 0;
@@ -49,12 +50,12 @@ struct VertexGuides {
   const DirectionalQuadtree* guide(TransportMode mode, Vec3 wo) const {
     if (!fields) return nullptr;
     const int side = side_of(n, wo);
-    if (!(resolved & (1u << side))) resolve(side);
+    if (!(resolved & (1u << (2 * int(mode) + side)))) resolve(mode, side);
     return guides[int(mode)][side];
   }
   // Only after guide() of the same mode and side.
   float bsdf_fraction(TransportMode mode, Vec3 wo) const { return bsdf[int(mode)][side_of(n, wo)]; }
-  void resolve(int side) const;  // bidir_guiding.cpp
+  void resolve(TransportMode mode, int side) const;  // bidir_guiding.cpp
 
   // The solid-angle density of the guide of (mode, side of wo) at wi; only after guide() found
   // one.

@@ -37,8 +37,8 @@ std::vector<IntegratorInfo> make_registry() {
                true, true, false, MisHeuristic::Power,
                [](const IntegratorSettings& s) { return std::make_unique<GuidedPathTracer>(s); }});
   r.push_back({"guided-bpt",
-               "bpt with camera subpaths guided by learned radiance and light subpaths by learned "
-               "importance (Vorba 2014), MIS over the guided densities",
+               "bpt with camera subpaths guided by radiance and light subpaths by importance, "
+               "both learned from the guided subpaths (Mueller 2017, Vorba 2014)",
                true, true, false, MisHeuristic::Balance, bidir(BidirAlgorithm::GuidedBpt)});
   r.push_back({"guided-vcm", "vcm with the guided subpaths of guided-bpt", false, true, true,
                MisHeuristic::Balance, bidir(BidirAlgorithm::GuidedVcm)});

@@ -2,7 +2,12 @@
 // Müller et al. 2017), one of the incident radiance, which guides camera subpaths, and one of
 // the incident importance, which guides light subpaths (Vorba et al. 2014, "On-line Learning of
 // Parametric Mixture Models for Light Transport Simulation": photons train the radiance,
-// "importons" the importance). Both come from the subpaths the core traces anyway:
+// "importons" the importance). Both come from the subpaths the core traces anyway. By default
+// (GuidingSettings::radiance_records, importance_records) each field learns from the subpaths it
+// guides, as guided-pt: a guided camera vertex records the radiance its later vertices found
+// through every technique, a guided light vertex the importance its later lens connections
+// found (camera_radiance_records.h); those records carry the product f |cos| L too, so the BSDF
+// selection probability is learned. Vorba et al.'s records, still available:
 //  - radiance: every stored light vertex (a photon) is a sample of the flux arriving at its
 //    position from its wo, weighted by its throughput: splatted at wo with the luminance of
 //    its throughput;
@@ -31,8 +36,9 @@
 //
 // Where a vertex is guided: where the BSDF has no delta or near-specular lobe and is not
 // stochastic (as guided-pt), once its leaf has learned something. The probability of sampling
-// the BSDF instead of the guide is fixed (--guiding-bsdf-fraction, default 0.5): the records
-// carry no product estimate to learn it from. Memory: each field gets half of --guiding-max-mb.
+// the BSDF instead of the guide is learned from the subpaths' own records, fixed at 0.5 for
+// photons and importons (no product estimate) or by --guiding-bsdf-fraction. Memory: each field
+// gets half of --guiding-max-mb.
 //
 // Determinism: the light vertices' records go to the field in the vertices' order, the camera
 // vertices' in (pixel, depth) order (pixel_records.h), both independent of threads.

@@ -33,8 +33,7 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
            "Mueller 2017 (default cosine)");
   o.choice("--guiding-subpaths", &s->guiding_subpaths, {"both", "camera", "light"},
            "Guiding (guided-bpt, guided-vcm): guide both subpaths, or only camera subpaths (by "
-           "the radiance learned from light vertices) or only light subpaths (by the importance "
-           "learned from camera vertices) (default both)");
+           "learned radiance) or only light subpaths (by learned importance) (default both)");
   o.choice("--guiding-radiance", &s->guiding_radiance, {"photons", "camera", "both"},
            "Guiding (guided-bpt, guided-vcm): what the radiance that guides camera subpaths is "
            "learned from: the light vertices (photons), the radiance the camera subpaths' own "

@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "integrators/bidir/bidir_core.h"
-#include "integrators/bidir/camera_radiance_records.h"
+#include "integrators/bidir/subpath_records.h"
 #include "integrators/bidir/subpath_step.h"
 #include "integrators/path_vertex.h"
 #include "lights/light.h"
@@ -90,14 +90,14 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   float segment = 0;
   float eta_scale = 1;
   bool through_interface = false;  // the ray passed a surface without a BSDF
+  // guided-bpt / guided-vcm learning radiance from camera subpaths: this pixel's records.
+  std::optional<SubpathRecords> radiance_records;
+  if (tech_.guided && guiding_.records_radiance_pixel(pixel))
+    radiance_records.emplace(arena, max_depth);
   // Emitters: MIS-weighted when connections take part, else only via delta-only chains. An
   // area light seen straight from the lens is weighted against the light subpaths' emission
   // points connected to the lens, unless the ray passed an interface (that connection's shadow
   // ray stops there).
-  // guided-bpt / guided-vcm learning radiance from camera subpaths: this pixel's records.
-  std::optional<CameraRadianceRecords> radiance_records;
-  if (tech_.guided && guiding_.records_radiance_pixel(pixel))
-    radiance_records.emplace(arena, max_depth);
   TechniqueTerms terms;
   bool weighted = false;  // the last emitter weight came from terms
   auto emitter_weight = [&](const Light& light, const SurfaceInteraction* hit, const MisSums& m) {
@@ -177,10 +177,10 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
       break;
   }
   if (radiance_records)
-    radiance_records->finish(
-        acc.sum, [&](const CameraRadianceRecords::Vertex& v, float radiance, float product) {
-          guiding_.record_camera_radiance(pixel, v, radiance, product);
-        });
+    radiance_records->finish(acc.sum,
+                             [&](const SubpathRecords::Vertex& v, float radiance, float product) {
+                               guiding_.record_camera_radiance(pixel, v, radiance, product);
+                             });
 }
 
 void BidirIntegrator::vertex_techniques(const Scene& scene, const Iteration& it,

@@ -50,13 +50,12 @@ void BidirGuiding::begin_iteration(uint32_t iteration, double elapsed, uint64_t 
   if (light_paths == 0) light_paths = pixels_;
   // About three guided vertices per light subpath.
   light_stride_ = std::max<uint64_t>(1, (3 * light_paths + kMaxRecords - 1) / kMaxRecords);
-  if (schedule_.learning() && importance_from_light_)
+  if (schedule_.learning() && guide_light_ && importance_from_light_)
     light_records_.begin_iteration(light_paths / light_stride_ + 1);
-  if (schedule_.learning()) {
+  if (schedule_.learning() && importance_from_camera_)
     camera_records_.begin_iteration(pixels_ / camera_stride_ + 1);
-    if (radiance_from_camera_)
-      camera_radiance_records_.begin_iteration(pixels_ / camera_stride_ + 1);
-  }
+  if (schedule_.learning() && guide_camera_ && radiance_from_camera_)
+    camera_radiance_records_.begin_iteration(pixels_ / camera_stride_ + 1);
 }
 
 bool BidirGuiding::end_pass_after(uint32_t iteration, double elapsed,
@@ -129,27 +128,17 @@ void BidirGuiding::record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 
                       value * float(camera_stride_)));
 }
 
-void BidirGuiding::record_camera_radiance(uint64_t pixel, const CameraRadianceRecords::Vertex& v,
-                                          float radiance, float product) const {
-  const float stride = float(camera_stride_);
-  GuidingRecord r = record_at(radiance_, pixel * kKeysPerPixel + uint64_t(v.depth), v.p, v.ng, v.wi,
-                              radiance * stride);
+void BidirGuiding::record_subpath_vertex(const GuidingField& field, const PixelRecords& records,
+                                         uint64_t subpath, uint64_t stride,
+                                         const SubpathRecords::Vertex& v, float value,
+                                         float product) const {
+  GuidingRecord r = record_at(field, subpath * kKeysPerPixel + uint64_t(v.depth), v.p, v.ng, v.wi,
+                              value * float(stride));
   // The BSDF selection learns where a guide sampled (guide_pdf > 0) and something was found.
-  r.product = product * stride;
+  r.product = product * float(stride);
   r.bsdf_pdf = v.bsdf_pdf;
   r.guide_pdf = v.guide_pdf;
-  camera_radiance_records_.writer(pixel / camera_stride_).push(r);
-}
-
-void BidirGuiding::record_light_importance(uint64_t path, const CameraRadianceRecords::Vertex& v,
-                                           float importance, float product) const {
-  const float stride = float(light_stride_);
-  GuidingRecord r = record_at(importance_, path * kKeysPerPixel + uint64_t(v.depth), v.p, v.ng,
-                              v.wi, importance * stride);
-  r.product = product * stride;
-  r.bsdf_pdf = v.bsdf_pdf;
-  r.guide_pdf = v.guide_pdf;
-  light_records_.writer(path / light_stride_).push(r);
+  records.writer(subpath / stride).push(r);
 }
 
 void BidirGuiding::learn(GuidingField& field, std::span<const std::span<const GuidingRecord>> runs,

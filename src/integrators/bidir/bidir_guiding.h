@@ -6,7 +6,7 @@
 // (GuidingSettings::radiance_records, importance_records) each field learns from the subpaths it
 // guides, as guided-pt: a guided camera vertex records the radiance its later vertices found
 // through every technique, a guided light vertex the importance its later lens connections
-// found (camera_radiance_records.h); those records carry the product f |cos| L too, so the BSDF
+// found (subpath_records.h); those records carry the product f |cos| L too, so the BSDF
 // selection probability is learned. Vorba et al.'s records, still available:
 //  - radiance: every stored light vertex (a photon) is a sample of the flux arriving at its
 //    position from its wo, weighted by its throughput: splatted at wo with the luminance of
@@ -54,8 +54,8 @@
 #include "guiding/pixel_records.h"
 #include "guiding/training_schedule.h"
 #include "image/inverse_variance.h"
-#include "integrators/bidir/camera_radiance_records.h"
 #include "integrators/bidir/light_vertex.h"
+#include "integrators/bidir/subpath_records.h"
 #include "integrators/bidir/vertex_guides.h"
 
 namespace caustica {
@@ -103,9 +103,11 @@ class BidirGuiding {
     return guide_light_ && importance_from_light_ && schedule_.learning() &&
            (path + iteration_) % light_stride_ == 0;
   }
-  // A light vertex of `path` received `importance` along its wi (camera_radiance_records.h).
-  void record_light_importance(uint64_t path, const CameraRadianceRecords::Vertex& v,
-                               float importance, float product) const;
+  // A light vertex of `path` received `importance` along its wi (subpath_records.h).
+  void record_light_importance(uint64_t path, const SubpathRecords::Vertex& v, float importance,
+                               float product) const {
+    record_subpath_vertex(importance_, light_records_, path, light_stride_, v, importance, product);
+  }
   // The camera subpath of `pixel` reached a non-delta vertex at p (geometric normal ng),
   // arriving along -wo with throughput beta (from estimate(): any thread).
   void record_camera_vertex(uint64_t pixel, int depth, Vec3 p, Vec3 ng, Vec3 wo, Rgb beta) const;
@@ -116,9 +118,12 @@ class BidirGuiding {
            (pixel + iteration_) % camera_stride_ == 0;
   }
   // A camera vertex of `pixel` received `radiance` along its wi, with `product` for the BSDF
-  // selection (camera_radiance_records.h).
-  void record_camera_radiance(uint64_t pixel, const CameraRadianceRecords::Vertex& v,
-                              float radiance, float product) const;
+  // selection (subpath_records.h).
+  void record_camera_radiance(uint64_t pixel, const SubpathRecords::Vertex& v, float radiance,
+                              float product) const {
+    record_subpath_vertex(radiance_, camera_radiance_records_, pixel, camera_stride_, v, radiance,
+                          product);
+  }
   // After the camera pass: learns from this iteration's light vertices (their normals from the
   // scene) and camera records (training passes only).
   void end_iteration(const Scene& scene, const std::vector<LightVertex>& light_vertices);
@@ -133,6 +138,11 @@ class BidirGuiding {
  private:
   friend struct VertexGuides;
   // A record of `value` arriving at p (geometric normal ng) along -wo.
+  // A subpath's own record (subpath_records.h): one record of `stride`, keyed by the subpath
+  // (pixel or light path) and the vertex's depth, in the subpath's slot of `records`.
+  void record_subpath_vertex(const GuidingField& field, const PixelRecords& records,
+                             uint64_t subpath, uint64_t stride, const SubpathRecords::Vertex& v,
+                             float value, float product) const;
   GuidingRecord record_at(const GuidingField& field, uint64_t key, Vec3 p, Vec3 ng, Vec3 wo,
                           float value) const;
   static void learn(GuidingField& field, std::span<const std::span<const GuidingRecord>> runs,

@@ -10,7 +10,7 @@
 
 #include "film/film.h"
 #include "integrators/bidir/bidir_core.h"
-#include "integrators/bidir/camera_radiance_records.h"
+#include "integrators/bidir/subpath_records.h"
 #include "integrators/bidir/subpath_step.h"
 #include "lights/light.h"
 #include "lights/light_sampler.h"
@@ -147,8 +147,8 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
 
   Ray ray = ray_leaving_light(*le, *light);
   // guided-bpt / guided-vcm learning importance from light subpaths: what each guided vertex's
-  // later vertices saw of the camera (camera_radiance_records.h, with importance).
-  std::optional<CameraRadianceRecords> importance_records;
+  // later vertices saw of the camera (subpath_records.h, with importance).
+  std::optional<SubpathRecords> importance_records;
   if (tech_.guided && guiding_.records_importance_path(path))
     importance_records.emplace(arena, max_depth);
   Rgb seen(0.f);  // the unweighted lens connections so far
@@ -213,7 +213,7 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
   }
   if (importance_records)
     importance_records->finish(
-        seen, [&](const CameraRadianceRecords::Vertex& v, float importance, float product) {
+        seen, [&](const SubpathRecords::Vertex& v, float importance, float product) {
           guiding_.record_light_importance(path, v, importance, product);
         });
 }

@@ -1,14 +1,18 @@
-// What one camera subpath of guided-bpt / guided-vcm teaches the radiance field when it learns
-// from camera subpaths (GuidingSettings::RadianceRecords): Müller et al. 2017, sec. 3.2, as
-// guided-pt records, with every technique of the bidirectional core as the estimate.
+// What one guided subpath of guided-bpt / guided-vcm teaches the field that guides it, when the
+// fields learn from the subpaths themselves (GuidingSettings::RadianceRecords and
+// ImportanceRecords): Müller et al. 2017, sec. 3.2, as guided-pt records.
 //
-// A guided camera vertex j sampled wi_j with density pdf_j and carries the throughput
-// beta_j after its scattering. Whatever the pixel's estimate gains after that (emitter hits,
-// next event estimation, connections and merges at later vertices, each MIS-weighted) is
-// beta_j times an estimate of the radiance arriving at j along wi_j, so the vertex's record is
-// L_j |cos| / pdf_j: summed over a directional quadrant, an estimate of the flux (times the
-// cosine, as the photons' records carry it) arriving through it. The gains are read off the
-// pixel's running sum (PixelAccumulator::sum), so the techniques need not know about guiding.
+// A guided vertex j sampled wi_j with density pdf_j and carries the throughput beta_j after its
+// scattering. Whatever the subpath's running sum gains after that is beta_j times an estimate of
+// what arrives at j along wi_j, so the vertex's record is that estimate times |cos| / pdf_j:
+// summed over a directional quadrant, an estimate of the flux (times the cosine, as photons
+// carry it) arriving through it.
+//  - camera subpaths: the sum is the pixel's estimate (PixelAccumulator::sum: emitter hits, next
+//    event estimation, connections and merges at later vertices, each MIS-weighted), and the
+//    record is incident radiance;
+//  - light subpaths: the sum is what the later vertices' connections to the lens found,
+//    unweighted, and the record is incident importance.
+// The gains are read off the running sum, so the techniques need not know about guiding.
 #pragma once
 
 #include <algorithm>
@@ -19,7 +23,7 @@
 
 namespace caustica::bidir {
 
-class CameraRadianceRecords {
+class SubpathRecords {
  public:
   struct Vertex {
     Vec3 p, ng, wi;
@@ -31,7 +35,7 @@ class CameraRadianceRecords {
     Rgb incident;                       // the radiance estimate arriving along wi
   };
 
-  CameraRadianceRecords(ScratchArena& arena, int max_vertices)
+  SubpathRecords(ScratchArena& arena, int max_vertices)
       : vertices_(static_cast<Vertex*>(
             arena.allocate(sizeof(Vertex) * size_t(std::max(max_vertices, 1)), alignof(Vertex)))),
         capacity_(std::max(max_vertices, 1)) {}

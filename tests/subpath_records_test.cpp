@@ -1,7 +1,7 @@
-// The camera subpaths' radiance records of guided-bpt / guided-vcm (camera_radiance_records.h):
+// The camera subpaths' radiance records of guided-bpt / guided-vcm (subpath_records.h):
 // what a pixel's estimate gains after a guided vertex is that vertex's incident radiance times
 // its throughput, and only what comes after it.
-#include "integrators/bidir/camera_radiance_records.h"
+#include "integrators/bidir/subpath_records.h"
 
 #include <gtest/gtest.h>
 
@@ -10,8 +10,8 @@
 namespace caustica::bidir {
 namespace {
 
-CameraRadianceRecords::Vertex vertex(int depth, float per_pdf, Rgb weight, Rgb beta_after) {
-  CameraRadianceRecords::Vertex v;
+SubpathRecords::Vertex vertex(int depth, float per_pdf, Rgb weight, Rgb beta_after) {
+  SubpathRecords::Vertex v;
   v.depth = depth;
   v.per_pdf = per_pdf;
   v.weight = weight;
@@ -24,9 +24,9 @@ struct Pushed {
   float radiance, product;
 };
 
-TEST(CameraRadianceRecords, EachVertexGetsWhatArrivedAfterItOverItsThroughput) {
+TEST(SubpathRecords, EachVertexGetsWhatArrivedAfterItOverItsThroughput) {
   ScratchArena arena;
-  CameraRadianceRecords records(arena, 8);
+  SubpathRecords records(arena, 8);
   Rgb sum(0.f);
   sum += Rgb(5.f);  // found at the first vertex (e.g. its next event): before any record
   records.gained(sum);
@@ -36,7 +36,7 @@ TEST(CameraRadianceRecords, EachVertexGetsWhatArrivedAfterItOverItsThroughput) {
   records.add(vertex(2, 2.f, Rgb(0.5f), Rgb(0.4f)));
   sum += Rgb(0.2f);  // at the third: arrives at both
   std::vector<Pushed> pushed;
-  records.finish(sum, [&](const CameraRadianceRecords::Vertex& v, float radiance, float product) {
+  records.finish(sum, [&](const SubpathRecords::Vertex& v, float radiance, float product) {
     pushed.push_back({v.depth, radiance, product});
   });
   ASSERT_EQ(pushed.size(), 2u);
@@ -51,30 +51,30 @@ TEST(CameraRadianceRecords, EachVertexGetsWhatArrivedAfterItOverItsThroughput) {
   EXPECT_NEAR(pushed[1].product, 0.25f, 1e-5f);
 }
 
-TEST(CameraRadianceRecords, VerticesThatReceivedNothingStillCount) {
+TEST(SubpathRecords, VerticesThatReceivedNothingStillCount) {
   // Every guided vertex counts for the spatial split rule, so each goes out, with zeros.
   ScratchArena arena;
-  CameraRadianceRecords records(arena, 4);
+  SubpathRecords records(arena, 4);
   records.gained(Rgb(0.f));
   records.add(vertex(1, 1.f, Rgb(1.f), Rgb(1.f)));
   records.add(vertex(2, 1.f, Rgb(1.f), Rgb(0.f)));  // a zero throughput receives nothing
   int count = 0;
-  records.finish(Rgb(3.f), [&](const CameraRadianceRecords::Vertex& v, float radiance, float) {
+  records.finish(Rgb(3.f), [&](const SubpathRecords::Vertex& v, float radiance, float) {
     EXPECT_FLOAT_EQ(radiance, v.depth == 1 ? 3.f : 0.f);
     ++count;
   });
   EXPECT_EQ(count, 2);
 }
 
-TEST(CameraRadianceRecords, KeepsAtMostItsCapacityAndNoUnusableDensities) {
+TEST(SubpathRecords, KeepsAtMostItsCapacityAndNoUnusableDensities) {
   ScratchArena arena;
-  CameraRadianceRecords records(arena, 2);
+  SubpathRecords records(arena, 2);
   records.add(vertex(1, 0.f, Rgb(1.f), Rgb(1.f)));  // no density: not a record
   records.add(vertex(2, 1.f, Rgb(1.f), Rgb(1.f)));
   records.add(vertex(3, 1.f, Rgb(1.f), Rgb(1.f)));
   records.add(vertex(4, 1.f, Rgb(1.f), Rgb(1.f)));  // beyond the capacity
   int count = 0;
-  records.finish(Rgb(1.f), [&](const CameraRadianceRecords::Vertex&, float, float) { ++count; });
+  records.finish(Rgb(1.f), [&](const SubpathRecords::Vertex&, float, float) { ++count; });
   EXPECT_EQ(count, 2);
 }
 

@@ -109,12 +109,17 @@ inline std::optional<GuidedSample> sample_guided(const Bsdf& bsdf, const VertexG
     if (!bs) return std::nullopt;
     s.wi = bs->wi;
     if (bs->is_transmission()) s.eta = bs->eta;
+    s.guide_pdf = g.guide_pdf(mode, wo, s.wi);
   } else {
-    s.wi = square_to_direction(guide.sample_square(u));
+    // The sampled point's leaf density is the guide's density of the direction (as guided-pt:
+    // the round trip through direction_to_square() agrees but within rounding at leaf borders),
+    // without a second descent.
+    float density;
+    s.wi = square_to_direction(guide.sample_square(u, &density));
+    s.guide_pdf = density * kInv4Pi;
   }
   const float bsdf_pdf = bsdf.pdf(wo, s.wi, mode);
   s.bsdf_pdf = bsdf_pdf;
-  s.guide_pdf = g.guide_pdf(mode, wo, s.wi);
   s.pdf = a * bsdf_pdf + (1 - a) * s.guide_pdf;
   if (!(s.pdf > 0)) return std::nullopt;
   const Rgb f_cos = bsdf.f(wo, s.wi, mode) * bsdf.abs_cos(s.wi);

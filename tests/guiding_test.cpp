@@ -731,3 +731,29 @@ TEST(GuidedVcm, BothMisWeightingsStayUnbiased) {
           << name << (guided_mis ? " mixture" : " bsdf");
     }
 }
+
+// guided-bpt and guided-vcm combine their passes by inverse variance, as guided-pt does: the
+// image is not the film's plain average, and each pass holds a whole iteration's estimate (the
+// camera estimates and the light-tracing splats: a pass without its splats lost light tracing's
+// share of the Cornell box, several standard errors).
+TEST(GuidedVcm, PassesCombineByInverseVarianceWithTheirSplats) {
+  auto scene = make_builtin_scene("cornell", 24, 24);
+  for (const char* name : {"guided-bpt", "guided-vcm"}) {
+    int differing = 0;
+    const auto difference = test::over_seeds(6, [&](uint64_t seed) {
+      IntegratorSettings s;
+      s.max_depth = 6;
+      s.seed = seed;
+      s.guiding.inverse_variance = true;
+      const Image combined = test::render_with(*scene, name, 32, s).image;
+      s.guiding.inverse_variance = false;
+      const Image average = test::render_with(*scene, name, 32, s).image;
+      differing += test::pixel_stats(combined).mean != test::pixel_stats(average).mean;
+      return test::pixel_stats(combined).mean - test::pixel_stats(average).mean;
+    });
+    std::printf("[ %s ] inverse variance - plain average: %.5f se %.5f\n", name, difference.mean,
+                difference.standard_error);
+    EXPECT_EQ(differing, 6) << name;
+    EXPECT_NEAR(difference.mean, 0.0, 3 * difference.standard_error + 1e-4) << name;
+  }
+}

@@ -47,8 +47,8 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
            "or from the BSDFs' alone, as unguided bpt/vcm (both unbiased; default bsdf: no guide "
            "densities outside sampling)");
   o.choice("--guiding-combine", &s->guiding_combine, {"inverse-variance", "equal"},
-           "Guiding: weight the training passes in the image by inverse variance, or every "
-           "iteration equally (default inverse-variance)");
+           "Guiding (guided-pt, guided-bpt, guided-vcm): weight the passes in the image by "
+           "inverse variance, or every iteration equally (default inverse-variance)");
 }
 
 }  // namespace

@@ -391,6 +391,7 @@ void GuidedPathTracer::report(nlohmann::json& stats) const {
   for (const InverseVarianceCombiner::Pass& p : passes_.passes())
     passes.push_back({{"spp", p.samples}, {"variance", p.variance}});
   g["passes"] = passes;
+  g["combine"] = settings_.guiding.inverse_variance ? "inverse-variance" : "equal";
   if (!views_.is_null()) g["views"] = views_;
   stats["guiding"] = g;
 }

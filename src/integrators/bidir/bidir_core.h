@@ -155,6 +155,13 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
   void report(nlohmann::json& stats) const override;
 
+  // guided-bpt / guided-vcm: the passes weighted by the inverse of their variance
+  // (--guiding-combine, as guided-pt; image/inverse_variance.h), else the film's plain average.
+  Image image(const Film& film) const override;
+  // guided-bpt / guided-vcm under MPI: the current pass's exact pixel moments, summed over the
+  // ranks (a pass that teaches is rendered whole by every rank: rank 0's is it).
+  std::span<FixedSum> sums_over_ranks(bool root) override;
+
   // guided-bpt / guided-vcm: the learned fields (tests).
   const BidirGuiding& guiding() const { return guiding_; }
 

@@ -176,12 +176,32 @@ void BidirIntegrator::finish(const Scene& scene, Film& film) {
     technique_files_ = techniques_.write(settings_.bidir.techniques_dir, film.iterations());
 }
 
+Image BidirIntegrator::image(const Film& film) const {
+  if (!tech_.guided || !settings_.guiding.inverse_variance) return film.image();
+  Image combined = guided_passes_.image();
+  return combined.empty() ? film.image() : combined;
+}
+
+std::span<FixedSum> BidirIntegrator::sums_over_ranks(bool root) {
+  if (!tech_.guided || !settings_.guiding.inverse_variance) return {};  // the film's image
+  if (!root && guiding_.teaches()) guided_passes_.clear_current();
+  return guided_passes_.current_sums();
+}
+
 void BidirIntegrator::report(nlohmann::json& stats) const {
   if (tech_.adaptive) {
     plan_.report(stats);
     stats["adaptive"]["path_tracer_iterations"] = path_tracing_iterations_;
   }
-  if (tech_.guided) guiding_.report(stats);
+  if (tech_.guided) {
+    guiding_.report(stats);
+    nlohmann::json passes = nlohmann::json::array();
+    for (const InverseVarianceCombiner::Pass& p : guided_passes_.passes())
+      passes.push_back({{"spp", p.samples}, {"variance", p.variance}});
+    stats["guiding"]["passes"] = passes;
+    stats["guiding"]["combine"] = settings_.guiding.inverse_variance ? "inverse-variance" : "equal";
+    stats["guiding"]["pass_image_bytes"] = guided_passes_.bytes();
+  }
   nlohmann::json b;
   b["algorithm"] = name();
   b["mis"] = heuristic_ == MisHeuristic::Power ? "power" : "balance";

@@ -589,6 +589,16 @@ TEST(GuidedPathTracer, RenderingTrainsTheField) {
   EXPECT_EQ(stats["guiding"]["rendering_from_iteration"], 8);
   EXPECT_EQ(stats["guiding"]["rendering_guided"], true);
   EXPECT_GT(stats["guiding"]["guiding_bytes"].get<size_t>(), 0u);
+  // Each pass: its samples per pixel, variance and seconds.
+  const nlohmann::json& passes = stats["guiding"]["passes"];
+  ASSERT_EQ(passes.size(), 4u);
+  int spp = 0;
+  for (const auto& p : passes) {
+    spp += p["spp"].get<int>();
+    EXPECT_GE(p["seconds"].get<double>(), 0.0);
+  }
+  EXPECT_EQ(spp, 16);
+  EXPECT_GT(passes[3]["variance"].get<double>(), 0.0);
   // The report's views of the learned field (guide_views.h): 9 pixels; where something was
   // learned, a density over the sphere that integrates to about 1 (midpoints of 32 x 16 cells).
   const nlohmann::json& views = stats["guiding"]["views"];

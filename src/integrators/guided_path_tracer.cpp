@@ -219,6 +219,7 @@ void GuidedPathTracer::prepare(const Scene& scene, Film& film) {
   schedule_ = TrainingSchedule(budget_spp(), budget_seconds());
   start_ = std::chrono::steady_clock::now();
   recorded_ = 0;
+  pass_end_seconds_.clear();
   peak_record_bytes_ = 0;
   record_stride_ = std::max<uint64_t>(
       1, (film.pixel_count() * kFirstRecordsPerPixel + kMaxRecords - 1) / kMaxRecords);
@@ -263,6 +264,7 @@ void GuidedPathTracer::end_pass_after(uint32_t iteration) {
   schedule_.end_pass(passes_.passes().back().variance);
   if (learned) field_.end_pass(k);
   passes_.end_pass();
+  pass_end_seconds_.push_back(seconds_since_start());
 }
 
 std::span<FixedSum> GuidedPathTracer::sums_over_ranks(bool root) {
@@ -388,8 +390,11 @@ void GuidedPathTracer::report(nlohmann::json& stats) const {
   g["radiance_samples_recorded"] = recorded_;
   g["mean_bsdf_fraction"] = field_.mean_bsdf_fraction();
   nlohmann::json passes = nlohmann::json::array();
-  for (const InverseVarianceCombiner::Pass& p : passes_.passes())
-    passes.push_back({{"spp", p.samples}, {"variance", p.variance}});
+  const std::vector<InverseVarianceCombiner::Pass> all = passes_.passes();
+  for (size_t k = 0; k < all.size(); ++k)
+    passes.push_back({{"spp", all[k].samples},
+                      {"variance", all[k].variance},
+                      {"seconds", pass_seconds(pass_end_seconds_, k, seconds_since_start())}});
   g["passes"] = passes;
   g["combine"] = settings_.guiding.inverse_variance ? "inverse-variance" : "equal";
   if (!views_.is_null()) g["views"] = views_;

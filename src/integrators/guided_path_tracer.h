@@ -120,6 +120,7 @@ class GuidedPathTracer final : public CameraPathIntegrator {
   nlohmann::json views_;  // what was learned at a few pixels (guide_views.h), by finish()
   // Written by estimate(): one writer per pixel at a time.
   mutable InverseVarianceCombiner passes_;
+  std::vector<double> pass_end_seconds_;  // when each completed pass ended (statistics)
 };
 
 }  // namespace caustica

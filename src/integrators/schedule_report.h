@@ -3,10 +3,19 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "guiding/training_schedule.h"
 
 namespace caustica {
+
+// Wall seconds of pass k, from when each completed pass ended (the last, current pass: until
+// `now`); 0 past the passes known.
+inline double pass_seconds(const std::vector<double>& ends, size_t k, double now) {
+  const double begin = k == 0 ? 0.0 : (k - 1 < ends.size() ? ends[k - 1] : now);
+  const double end = k < ends.size() ? ends[k] : now;
+  return end > begin ? end - begin : 0.0;
+}
 
 inline void report_schedule(const TrainingSchedule& s, nlohmann::json& g) {
   g["passes_started"] = s.pass() + 1;

@@ -327,6 +327,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
   // (camera_values_: this iteration's camera estimate per pixel, each written by its task).
   BidirGuiding guiding_;
   InverseVarianceCombiner guided_passes_;
+  std::vector<double> pass_end_seconds_;  // when each completed pass ended (statistics)
   mutable std::vector<Rgb> camera_values_;
   std::chrono::steady_clock::time_point start_;
 

@@ -7,6 +7,7 @@
 
 #include "film/film.h"
 #include "integrators/bidir/bidir_core.h"
+#include "integrators/schedule_report.h"
 #include "scene/scene.h"
 
 namespace caustica {
@@ -84,6 +85,7 @@ void BidirIntegrator::prepare(const Scene& scene, Film& film) {
                      budget_seconds());
     guided_passes_ = InverseVarianceCombiner(film.width(), film.height());
     camera_values_.assign(film.pixel_count(), Rgb(0.f));
+    pass_end_seconds_.clear();
     start_ = std::chrono::steady_clock::now();
   }
   if (tech_.adaptive)
@@ -152,8 +154,10 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
     for (size_t p = 0; p < camera_values_.size(); ++p)
       guided_passes_.add(p, camera_values_[p] + splat_image_[p]);
     guided_passes_.end_iteration();
-    if (guiding_.end_pass_after(iteration, seconds_since(start_), guided_passes_))
+    if (guiding_.end_pass_after(iteration, seconds_since(start_), guided_passes_)) {
       guided_passes_.end_pass();
+      pass_end_seconds_.push_back(seconds_since(start_));
+    }
   }
   probe_.light_vertices = double(vertices_.size());
   add_counts(work_total_, probe_);
@@ -196,8 +200,11 @@ void BidirIntegrator::report(nlohmann::json& stats) const {
   if (tech_.guided) {
     guiding_.report(stats);
     nlohmann::json passes = nlohmann::json::array();
-    for (const InverseVarianceCombiner::Pass& p : guided_passes_.passes())
-      passes.push_back({{"spp", p.samples}, {"variance", p.variance}});
+    const std::vector<InverseVarianceCombiner::Pass> all = guided_passes_.passes();
+    for (size_t k = 0; k < all.size(); ++k)
+      passes.push_back({{"spp", all[k].samples},
+                        {"variance", all[k].variance},
+                        {"seconds", pass_seconds(pass_end_seconds_, k, seconds_since(start_))}});
     stats["guiding"]["passes"] = passes;
     stats["guiding"]["combine"] = settings_.guiding.inverse_variance ? "inverse-variance" : "equal";
     stats["guiding"]["pass_image_bytes"] = guided_passes_.bytes();

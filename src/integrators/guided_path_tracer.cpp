@@ -386,17 +386,10 @@ void GuidedPathTracer::report(nlohmann::json& stats) const {
   g["guiding_max_bytes"] = settings_.guiding.max_bytes;
   g["record_buffer_peak_bytes"] = peak_record_bytes_;
   g["record_pixel_stride_last"] = record_stride_;
-  g["pass_image_bytes"] = passes_.bytes();
   g["radiance_samples_recorded"] = recorded_;
   g["mean_bsdf_fraction"] = field_.mean_bsdf_fraction();
-  nlohmann::json passes = nlohmann::json::array();
-  const std::vector<InverseVarianceCombiner::Pass> all = passes_.passes();
-  for (size_t k = 0; k < all.size(); ++k)
-    passes.push_back({{"spp", all[k].samples},
-                      {"variance", all[k].variance},
-                      {"seconds", pass_seconds(pass_end_seconds_, k, seconds_since_start())}});
-  g["passes"] = passes;
-  g["combine"] = settings_.guiding.inverse_variance ? "inverse-variance" : "equal";
+  report_passes(passes_, settings_.guiding.inverse_variance, pass_end_seconds_,
+                seconds_since_start(), g);
   if (!views_.is_null()) g["views"] = views_;
   stats["guiding"] = g;
 }

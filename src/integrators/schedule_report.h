@@ -6,15 +6,27 @@
 #include <vector>
 
 #include "guiding/training_schedule.h"
+#include "image/inverse_variance.h"
 
 namespace caustica {
 
-// Wall seconds of pass k, from when each completed pass ended (the last, current pass: until
-// `now`); 0 past the passes known.
-inline double pass_seconds(const std::vector<double>& ends, size_t k, double now) {
-  const double begin = k == 0 ? 0.0 : (k - 1 < ends.size() ? ends[k - 1] : now);
-  const double end = k < ends.size() ? ends[k] : now;
-  return end > begin ? end - begin : 0.0;
+// The passes of a guided integrator's image (image/inverse_variance.h): how they combine, and
+// each pass's samples per pixel, variance and wall seconds, from when each completed pass ended
+// (`ends`; the current pass until `now`).
+inline void report_passes(const InverseVarianceCombiner& combiner, bool inverse_variance,
+                          const std::vector<double>& ends, double now, nlohmann::json& g) {
+  nlohmann::json passes = nlohmann::json::array();
+  const std::vector<InverseVarianceCombiner::Pass> all = combiner.passes();
+  for (size_t k = 0; k < all.size(); ++k) {
+    const double begin = k == 0 ? 0.0 : (k - 1 < ends.size() ? ends[k - 1] : now);
+    const double end = k < ends.size() ? ends[k] : now;
+    passes.push_back({{"spp", all[k].samples},
+                      {"variance", all[k].variance},
+                      {"seconds", end > begin ? end - begin : 0.0}});
+  }
+  g["passes"] = passes;
+  g["combine"] = inverse_variance ? "inverse-variance" : "equal";
+  g["pass_image_bytes"] = combiner.bytes();
 }
 
 inline void report_schedule(const TrainingSchedule& s, nlohmann::json& g) {

@@ -199,15 +199,8 @@ void BidirIntegrator::report(nlohmann::json& stats) const {
   }
   if (tech_.guided) {
     guiding_.report(stats);
-    nlohmann::json passes = nlohmann::json::array();
-    const std::vector<InverseVarianceCombiner::Pass> all = guided_passes_.passes();
-    for (size_t k = 0; k < all.size(); ++k)
-      passes.push_back({{"spp", all[k].samples},
-                        {"variance", all[k].variance},
-                        {"seconds", pass_seconds(pass_end_seconds_, k, seconds_since(start_))}});
-    stats["guiding"]["passes"] = passes;
-    stats["guiding"]["combine"] = settings_.guiding.inverse_variance ? "inverse-variance" : "equal";
-    stats["guiding"]["pass_image_bytes"] = guided_passes_.bytes();
+    report_passes(guided_passes_, settings_.guiding.inverse_variance, pass_end_seconds_,
+                  seconds_since(start_), stats["guiding"]);
   }
   nlohmann::json b;
   b["algorithm"] = name();

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/arena.h"
 #include "core/rgb.h"

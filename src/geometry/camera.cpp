@@ -81,7 +81,7 @@ void Camera::pdf_we(Vec3 p_lens, Vec3 dir, float* pdf_pos, float* pdf_dir) const
     return;
   }
   *pdf_pos = 1.f / lens_area();
-  *pdf_dir = 1.f / (image_plane_area_ * cos_theta * cos_theta * cos_theta);
+  *pdf_dir = pdf_dir_on_film(dir);
 }
 
 std::optional<CameraWiSample> Camera::sample_wi(Vec3 ref, Vec2 u_lens) const {

@@ -293,6 +293,40 @@ TEST(Guiding, FilteredSplatConservesEnergy) {
   EXPECT_NEAR(flat.pdf_square({0.25f, 0.25f}), 4.0, 1e-6);
 }
 
+// A refined tree that carries the energy (--guiding-carry) keeps the distribution: a quadrant
+// refined deeper spreads its energy evenly (the same density), a subtree that collapses keeps
+// its sum, and the total is scaled by the carried share.
+TEST(Guiding, RefinedTreeCarriesTheDistribution) {
+  DirectionalQuadtree flat;
+  const Vec2 centre[4] = {{0.25f, 0.25f}, {0.75f, 0.25f}, {0.25f, 0.75f}, {0.75f, 0.75f}};
+  const double energy[4] = {5, 3, 1.5, 0.5};
+  for (int q = 0; q < 4; ++q) flat.record(centre[q], energy[q]);
+  flat.propagate();
+  size_t budget = 1000;
+  DirectionalQuadtree carried = flat.refined(0.2, 20, &budget, 0.5);
+  EXPECT_EQ(carried.node_count(), 3u) << "the quadrants holding 50% and 30% are refined";
+  carried.propagate();
+  EXPECT_NEAR(carried.total(), 0.5 * flat.total(), 1e-6);
+  Pcg32 rng(3, 4);
+  for (int i = 0; i < 100; ++i) {
+    const Vec2 p = rng.next_2d();
+    ASSERT_NEAR(carried.pdf_square(p), flat.pdf_square(p), 1e-5) << p.x << " " << p.y;
+  }
+  // Collapsing: refined with rho = 1 the tree is one node again, each quadrant its subtree's sum.
+  budget = 1000;
+  DirectionalQuadtree collapsed = carried.refined(1.0, 20, &budget, 1.0);
+  EXPECT_EQ(collapsed.node_count(), 1u);
+  collapsed.propagate();
+  EXPECT_NEAR(collapsed.total(), carried.total(), 1e-6);
+  for (int q = 0; q < 4; ++q)
+    EXPECT_NEAR(collapsed.pdf_square(centre[q]), 4 * energy[q] / 10, 1e-5) << q;
+  // Without carry the energies are zero (Müller 2017).
+  budget = 1000;
+  DirectionalQuadtree fresh = flat.refined(0.2, 20, &budget);
+  fresh.propagate();
+  EXPECT_EQ(fresh.total(), 0);
+}
+
 // The stochastic directional filter (the one the field uses) is the deterministic box filter
 // in expectation: many jittered splats of one point match one box-filtered splat.
 TEST(Guiding, JitteredSplatsAverageToTheBoxFilter) {

@@ -19,6 +19,10 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
   o.number("--guiding-rho", &s->guiding.rho, 0, 1, true,
            "Guiding: refine a directional quadrant holding more than this share of the energy "
            "(default 0.05; Mueller 2017: 0.01)");
+  o.number("--guiding-carry", &s->guiding.carry, 0, 1, false,
+           "Guiding: share of a spatial leaf's learned energy that the next training pass starts "
+           "from, 0..1 (default 0.5; 0: each pass learns from its own samples alone, as Mueller "
+           "2017)");
   o.integer("--guiding-max-mb", &s->guiding_max_mb, 1, 65536,
             "Guiding: memory cap of the learned structure in MiB (default 32)");
   o.number("--guiding-bsdf-fraction", &s->guiding.bsdf_fraction, 0, 1, true,

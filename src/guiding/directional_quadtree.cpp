@@ -207,8 +207,8 @@ Vec2 DirectionalQuadtree::sample_square(Vec2 u, float* pdf) const {
   return {inside(ox, ux), inside(oy, uy)};
 }
 
-DirectionalQuadtree DirectionalQuadtree::refined(double rho, int max_depth,
-                                                 size_t* node_budget) const {
+DirectionalQuadtree DirectionalQuadtree::refined(double rho, int max_depth, size_t* node_budget,
+                                                 double carry) const {
   DirectionalQuadtree out;
   const double whole = total();
   if (!(whole > 0)) return out;
@@ -236,6 +236,8 @@ DirectionalQuadtree DirectionalQuadtree::refined(double rho, int max_depth,
         out.nodes_.emplace_back();
         out.nodes_[at.node].child[q] = child;
         stack.push_back({child, old_child, at.depth + 1, share});
+      } else {
+        out.nodes_[at.node].energy[q] = float(carry * share * whole);  // a leaf quadrant
       }
     }
   }

@@ -67,9 +67,11 @@ class DirectionalQuadtree {
   // The structure for the next training iteration (Müller et al. 2017, sec. 3.4): a quadrant is
   // subdivided where its share of the total energy exceeds rho (a leaf's share split evenly
   // among its would-be children), up to max_depth levels; everything else collapses. The
-  // energies of the result are zero. At most *node_budget nodes are created (beyond the root),
-  // and *node_budget is decremented by what was.
-  DirectionalQuadtree refined(double rho, int max_depth, size_t* node_budget) const;
+  // energies of the result are `carry` times this tree's, spread over its leaf quadrants by
+  // their shares (0: empty). At most *node_budget nodes are created (beyond the root), and
+  // *node_budget is decremented by what was.
+  DirectionalQuadtree refined(double rho, int max_depth, size_t* node_budget,
+                              double carry = 0) const;
 
   size_t node_count() const { return nodes_.size(); }
   size_t bytes() const {

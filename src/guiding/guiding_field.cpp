@@ -281,6 +281,7 @@ void GuidingField::split(uint32_t node, std::vector<uint64_t>& counts, int split
                                         : (d.x >= d.y && d.x >= d.z ? 0 : (d.y >= d.z ? 1 : 2));
   const float middle = 0.5f * (box.lo[int(axis)] + box.hi[int(axis)]);
   counts[leaf] /= 2;
+  leaves_[leaf].carry_share *= 0.5;
   const uint32_t copy = uint32_t(leaves_.size());
   leaves_.push_back(leaves_[leaf]);
   counts.push_back(counts[leaf]);
@@ -333,7 +334,9 @@ void GuidingField::end_pass(int k) {
                       ? (settings_.max_bytes - bytes) / DirectionalQuadtree::kNodeBytes
                       : 0;
   for (Leaf& l : leaves_) {
-    l.recording = l.sampling.refined(settings_.rho, settings_.max_quadtree_depth, &budget);
+    l.recording = l.sampling.refined(settings_.rho, settings_.max_quadtree_depth, &budget,
+                                     settings_.carry * l.carry_share);
+    l.carry_share = 1;
     l.recording.shrink_to_fit();
   }
   counts_.assign(leaves_.size(), 0);

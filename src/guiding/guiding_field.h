@@ -12,7 +12,8 @@
 //     two at the middle of its box's longest axis (the children copy its distributions, its
 //     selection optimizer and half its weight), repeatedly;
 //  3. each leaf's recording structure is rebuilt from its sampling distribution, refining
-//     quadrants whose energy share exceeds rho (zero energies).
+//     quadrants whose energy share exceeds rho, and starts from GuidingSettings::carry of that
+//     distribution's energy (Müller: zero).
 //
 // Memory cap: the whole structure (memory_bytes(): spatial nodes, leaves and every quadtree)
 // stays under GuidingSettings::max_bytes. Splits and refinements that would exceed it are not
@@ -131,6 +132,7 @@ class GuidingField {
     Bounds3 box;
     DirectionalQuadtree sampling, recording;
     SelectionOptimizer selection;
+    double carry_share = 1;  // of its distribution's energy, halved at each split (carry)
   };
   void record_into(Leaf& leaf, const GuidingRecord& r);
   // Splits a leaf node in two at the middle of `axis` (-1: its box's longest axis).

@@ -585,6 +585,15 @@ TEST(PbrtHostile, NegativeRoughnessIsAnError) {
             "got -1");
 }
 
+TEST(PbrtHostile, CoatedConductorWithReflectanceAndEtaIsAnError) {
+  EXPECT_EQ(load_error(with_sphere("Material \"coatedconductor\" \"rgb reflectance\" [0.5 0.5 0.5] "
+                                   "\"spectrum conductor.eta\" \"metal-Au-eta\"\n")),
+            "test.pbrt:4:1: error: coatedconductor: \"reflectance\" cannot be combined with "
+            "\"conductor.eta\" or \"conductor.k\"");
+  EXPECT_EQ(load_error(with_sphere("Material \"coatedconductor\" \"float interface.eta\" 0\n")),
+            "test.pbrt:4:28: error: \"float interface.eta\": interface.eta must be positive");
+}
+
 TEST(PbrtHostile, MixAmountOutsideZeroOneIsAnError) {
   const std::string two =
       "MakeNamedMaterial \"a\" \"string type\" \"diffuse\"\n"

@@ -7,9 +7,11 @@
 #include <cmath>
 #include <filesystem>
 
+#include "core/arena.h"
 #include "geometry/interaction.h"
 #include "io/pbrt/color.h"
 #include "lights/light.h"
+#include "materials/material.h"
 #include "pbrt_test_util.h"
 #include "test_scenes.h"
 
@@ -135,6 +137,21 @@ TEST(PbrtShapes, PartialSphereIsTessellatedWithAWarning) {
   // inside of the cap.
   const SurfaceInteraction si = hit(*scene, {0, 0, -5}, {0, 0, 1});
   EXPECT_NEAR(si.p.z, 1, 1e-3f);
+}
+
+TEST(PbrtMaterials, CoatedConductorIsTheLayeredBsdfNotTheBareMetal) {
+  test::captured_warnings().clear();
+  auto scene = load_text(with_camera(
+      "Material \"coatedconductor\" \"float interface.roughness\" 0.05 \"float interface.eta\" "
+      "1.4 \"spectrum conductor.eta\" \"metal-Au-eta\" \"spectrum conductor.k\" \"metal-Au-k\" "
+      "\"float conductor.roughness\" 0.2 \"float thickness\" 0.02 \"integer maxdepth\" 8\n"
+      "Translate 0 0 10\nShape \"sphere\"\n"));
+  EXPECT_TRUE(test::captured_warnings().empty());
+  const SurfaceInteraction si = hit(*scene, {0, 0, 0}, {0, 0, 1});
+  ASSERT_TRUE(si.material);
+  EXPECT_STREQ(si.material->name(), "coatedconductor");
+  ScratchArena arena;
+  EXPECT_TRUE(si.material->bsdf(si, arena).stochastic());
 }
 
 TEST(PbrtShapes, DiskNormalIsPlusZ) {

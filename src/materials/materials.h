@@ -50,6 +50,21 @@ struct CoatedDiffuseParams {
 };
 MaterialPtr make_coated_diffuse(const CoatedDiffuseParams& params);
 
+// pbrt-v4 "coatedconductor": a dielectric coat over a conductor (the same stochastic layered
+// BSDF); the conductor's eta and k are relative to the coat (divided by interface_eta).
+struct CoatedConductorParams {
+  TexturePtr interface_u_roughness, interface_v_roughness;  // of the coat (null: smooth)
+  float interface_eta = 1.5f;
+  float thickness = 0.01f;
+  TexturePtr eta, k;       // the conductor's complex IOR (default metal-Cu), unless reflectance
+  TexturePtr reflectance;  // optional: eta = 1, k = 2 sqrt(r) / sqrt(1 - r)
+  TexturePtr conductor_u_roughness, conductor_v_roughness;  // null: smooth
+  bool remap_roughness = true;
+  TexturePtr albedo, g;  // the medium between the layers (default 0)
+  int max_depth = 10, n_samples = 1;
+};
+MaterialPtr make_coated_conductor(const CoatedConductorParams& params);
+
 // pbrt-v4 "diffusetransmission": Lambertian reflection and transmission.
 MaterialPtr make_diffuse_transmission(TexturePtr reflectance, TexturePtr transmittance,
                                       float scale = 1.f);

@@ -240,10 +240,10 @@ void MaterialFactory::roughness(const ParamList& params, const std::string& pref
   *remap = params.get_bool("remaproughness", true);
 }
 
-// "eta" as one positive index of refraction, 1.5 if absent.
-float MaterialFactory::eta(const ParamList& params) {
+// An index of refraction ("eta", "interface.eta") as one positive value, 1.5 if absent.
+float MaterialFactory::eta(const ParamList& params, const std::string& name) {
   const Param* p = params.find(
-      "eta", {ParamType::Float, ParamType::Spectrum, ParamType::Rgb, ParamType::Texture});
+      name, {ParamType::Float, ParamType::Spectrum, ParamType::Rgb, ParamType::Texture});
   float value = 1.5f;
   if (p && p->type == ParamType::Float) {
     if (p->numbers.size() != 1) param_error(*p, "expected one value");
@@ -254,7 +254,7 @@ float MaterialFactory::eta(const ParamList& params) {
     // Spectrally varying IORs (dispersion) are reduced to one value.
     value = spectrum_param_rgb(*p, SpectrumKind::Unbounded, ctx_).g;
   }
-  if (!(value > 0)) param_error(*params.find("eta"), "eta must be positive");
+  if (!(value > 0)) param_error(*params.find(name), name + " must be positive");
   return value;
 }
 
@@ -268,7 +268,8 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
   const float kInf = std::numeric_limits<float>::infinity();
   // Negative roughness has no meaning (and its remapped alpha, sqrt(roughness), is NaN).
   for (const char* name : {"roughness", "uroughness", "vroughness", "conductor.roughness",
-                           "conductor.uroughness", "conductor.vroughness"})
+                           "conductor.uroughness", "conductor.vroughness", "interface.roughness",
+                           "interface.uroughness", "interface.vroughness"})
     check_constant_range(params, name, 0, kInf, "a roughness >= 0");
 
   MaterialPtr m;
@@ -276,15 +277,17 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
     m = nullptr;
   } else if (type == "diffuse") {
     m = make_diffuse(spectrum_texture(params, "reflectance", Rgb(0.5f), SpectrumKind::Albedo));
-  } else if (type == "conductor" || type == "coatedconductor") {
-    m = conductor(type, params, where);
+  } else if (type == "conductor") {
+    m = conductor(params, where);
+  } else if (type == "coatedconductor") {
+    m = coated_conductor(params, where);
   } else if (type == "dielectric") {
     DielectricParams d;
-    d.eta = eta(params);
+    d.eta = eta(params, "eta");
     roughness(params, "", &d.u_roughness, &d.v_roughness, &d.remap_roughness);
     m = make_dielectric(d);
   } else if (type == "thindielectric") {
-    m = make_thin_dielectric(eta(params));
+    m = make_thin_dielectric(eta(params, "eta"));
   } else if (type == "coateddiffuse") {
     m = coated_diffuse(params, where);
   } else if (type == "diffusetransmission") {
@@ -310,39 +313,63 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
   return m;
 }
 
-// "conductor", or "coatedconductor" reduced to its conductor (parameters "conductor.*").
-MaterialPtr MaterialFactory::conductor(const std::string& type, const ParamList& params,
-                                       const SourceLocation& where) {
-  const std::string prefix = type == "coatedconductor" ? "conductor." : "";
-  if (type == "coatedconductor") {
-    ctx_.warnings.warn(
-        where,
-        "material \"coatedconductor\" is not supported; using its conductor without the coat",
-        "coatedconductor");
-    for (const Param& p : params.all())
-      if (p.name.rfind("interface.", 0) == 0 || p.name == "thickness" || p.name == "albedo" ||
-          p.name == "g" || p.name == "maxdepth" || p.name == "nsamples")
-        p.used = true;
+// The conductor's complex IOR or reflectance (names after `prefix` for eta and k: "conductor."
+// for coatedconductor), with pbrt-v4's copper default.
+void MaterialFactory::conductor_ior(const ParamList& params, const std::string& prefix,
+                                    const std::string& type, const SourceLocation& where,
+                                    TexturePtr* eta, TexturePtr* k, TexturePtr* reflectance) {
+  *reflectance = spectrum_texture(params, "reflectance", std::nullopt, SpectrumKind::Albedo);
+  *eta = spectrum_texture(params, prefix + "eta", std::nullopt, SpectrumKind::Unbounded);
+  *k = spectrum_texture(params, prefix + "k", std::nullopt, SpectrumKind::Unbounded);
+  if (*reflectance && (*eta || *k))
+    throw SceneLoadError(where, type + ": \"reflectance\" cannot be combined with \"" + prefix +
+                                    "eta\" or \"" + prefix + "k\"");
+  if (!*reflectance) {
+    if (!*eta)
+      *eta = make_constant_texture(named_spectrum("metal-Cu-eta").value_or(Rgb(0.2f, 0.92f, 1.1f)));
+    if (!*k)
+      *k = make_constant_texture(named_spectrum("metal-Cu-k").value_or(Rgb(3.9f, 2.45f, 2.14f)));
   }
+}
+
+MaterialPtr MaterialFactory::conductor(const ParamList& params, const SourceLocation& where) {
   ConductorParams c;
-  c.reflectance =
-      spectrum_texture(params, prefix + "reflectance", std::nullopt, SpectrumKind::Albedo);
-  c.eta = spectrum_texture(params, prefix + "eta", std::nullopt, SpectrumKind::Unbounded);
-  c.k = spectrum_texture(params, prefix + "k", std::nullopt, SpectrumKind::Unbounded);
-  if (c.reflectance && (c.eta || c.k))
-    throw SceneLoadError(where,
-                         type + ": \"reflectance\" cannot be combined with \"eta\" or \"k\"");
-  if (!c.reflectance) {
-    if (!c.eta)
-      c.eta =
-          make_constant_texture(named_spectrum("metal-Cu-eta").value_or(Rgb(0.2f, 0.92f, 1.1f)));
-    if (!c.k)
-      c.k = make_constant_texture(named_spectrum("metal-Cu-k").value_or(Rgb(3.9f, 2.45f, 2.14f)));
-  }
-  roughness(params, prefix, &c.u_roughness, &c.v_roughness, &c.remap_roughness);
+  conductor_ior(params, "", "conductor", where, &c.eta, &c.k, &c.reflectance);
+  roughness(params, "", &c.u_roughness, &c.v_roughness, &c.remap_roughness);
   if (!c.u_roughness && c.reflectance && is_constant_value(c.reflectance, 1.f))
     return make_mirror(Rgb(1.f));  // pbrt-v4's conductor with reflectance 1 is a perfect mirror
   return make_conductor(c);
+}
+
+MaterialPtr MaterialFactory::coated_conductor(const ParamList& params,
+                                              const SourceLocation& where) {
+  CoatedConductorParams c;
+  roughness(params, "interface.", &c.interface_u_roughness, &c.interface_v_roughness,
+            &c.remap_roughness);
+  roughness(params, "conductor.", &c.conductor_u_roughness, &c.conductor_v_roughness,
+            &c.remap_roughness);
+  c.interface_eta = eta(params, "interface.eta");
+  conductor_ior(params, "conductor.", "coatedconductor", where, &c.eta, &c.k, &c.reflectance);
+  c.thickness = thickness(params);
+  c.albedo = spectrum_texture(params, "albedo", Rgb(0.f), SpectrumKind::Albedo);
+  c.g = float_texture(params, "g", 0.f);
+  c.max_depth = params.get_int("maxdepth", 10);
+  c.n_samples = params.get_int("nsamples", 1);
+  if (c.max_depth < 1 || c.n_samples < 1 || c.max_depth > 1000 || c.n_samples > 1000)
+    throw SceneLoadError(where,
+                         "coatedconductor: maxdepth and nsamples must be between 1 and 1000");
+  return make_coated_conductor(c);
+}
+
+// "thickness" of a coat: a positive float (0.01 if absent); textured thickness is warned.
+float MaterialFactory::thickness(const ParamList& params) {
+  const Param* tp = params.find("thickness", {ParamType::Float, ParamType::Texture});
+  if (tp && tp->type == ParamType::Texture) {
+    ctx_.warnings.warn(tp->where, "textured coating thickness is not supported; using 0.01",
+                       "textured thickness");
+    return 0.01f;
+  }
+  return params.get_float("thickness", 0.01f);
 }
 
 MaterialPtr MaterialFactory::coated_diffuse(const ParamList& params, const SourceLocation& where) {
@@ -350,13 +377,8 @@ MaterialPtr MaterialFactory::coated_diffuse(const ParamList& params, const Sourc
   c.reflectance = spectrum_texture(params, "reflectance", Rgb(0.5f), SpectrumKind::Albedo);
   roughness(params, "", &c.u_roughness, &c.v_roughness, &c.remap_roughness);
   if (!c.u_roughness) c.u_roughness = c.v_roughness = make_constant_texture(Rgb(0.f));
-  const Param* tp = params.find("thickness", {ParamType::Float, ParamType::Texture});
-  if (tp && tp->type == ParamType::Texture)
-    ctx_.warnings.warn(tp->where, "textured coating thickness is not supported; using 0.01",
-                       "textured thickness");
-  else
-    c.thickness = params.get_float("thickness", 0.01f);
-  c.eta = eta(params);
+  c.thickness = thickness(params);
+  c.eta = eta(params, "eta");
   c.albedo = spectrum_texture(params, "albedo", Rgb(0.f), SpectrumKind::Albedo);
   c.g = float_texture(params, "g", 0.f);
   c.max_depth = params.get_int("maxdepth", 10);

@@ -7,8 +7,8 @@
 //
 // Materials: diffuse, conductor (eta/k or reflectance; roughness, uroughness, vroughness,
 // remaproughness), dielectric (eta as float or named spectrum), thindielectric,
-// coateddiffuse, diffusetransmission, mix, and interface (no surface: a null material).
-// coatedconductor, measured, hair and subsurface warn and fall back to a simpler model.
+// coateddiffuse, coatedconductor, diffusetransmission, mix, and interface (no surface: a null
+// material). measured, hair and subsurface warn and fall back to diffuse.
 #pragma once
 
 #include <functional>
@@ -54,9 +54,13 @@ class MaterialFactory {
  private:
   void roughness(const ParamList& params, const std::string& prefix, TexturePtr* u, TexturePtr* v,
                  bool* remap);
-  float eta(const ParamList& params);
-  MaterialPtr conductor(const std::string& type, const ParamList& params,
-                        const SourceLocation& where);
+  float eta(const ParamList& params, const std::string& name);
+  float thickness(const ParamList& params);
+  void conductor_ior(const ParamList& params, const std::string& prefix, const std::string& type,
+                     const SourceLocation& where, TexturePtr* eta, TexturePtr* k,
+                     TexturePtr* reflectance);
+  MaterialPtr conductor(const ParamList& params, const SourceLocation& where);
+  MaterialPtr coated_conductor(const ParamList& params, const SourceLocation& where);
   MaterialPtr coated_diffuse(const ParamList& params, const SourceLocation& where);
   MaterialPtr mix(const ParamList& params, const SourceLocation& where,
                   const NamedMaterialLookup& named);

@@ -7,6 +7,7 @@
 #include "core/math.h"
 #include "film/film.h"
 #include "integrators/guide_views.h"
+#include "integrators/guided_mixture.h"
 #include "integrators/path_vertex.h"
 #include "integrators/schedule_report.h"
 #include "lights/light.h"
@@ -22,91 +23,15 @@ namespace {
 // per scattering vertex, and at most 255 vertices).
 constexpr uint64_t kKeysPerPixel = 512;
 
-// The densities of one direction, evaluated once: where it lies on the guide's square, the
-// BSDF's density and the learned one (0 without a guide).
-struct DirectionPdfs {
-  Vec2 square;
-  float bsdf = 0, guide = 0;
-};
-
-// The one-sample MIS mixture at a vertex (Veach 1997, sec. 9.2.4): the BSDF with probability
-// bsdf_fraction, else the learned distribution; without one (guide == nullptr), the BSDF alone.
-struct Mixture {
-  const DirectionalQuadtree* guide = nullptr;
-  float bsdf_fraction = 1;
-  uint32_t record_leaf = 0;  // where this vertex's records go (the spatial filter's jitter)
-  bool guidable = false;     // records are learned here
-  // The records' weight along wi: |cos| to the shading normal where the guides learn the
-  // product with the cosine (GuidingSettings::cosine_product), else 1.
-  Vec3 cosine_normal;
-  float record_weight(Vec3 wi) const {
-    return cosine_normal == Vec3() ? 1.f : std::abs(dot(cosine_normal, wi));
-  }
-
-  DirectionPdfs evaluate(const Bsdf& bsdf, Vec3 wo, Vec3 wi) const {
-    DirectionPdfs d;
-    d.square = direction_to_square(wi);
-    d.bsdf = bsdf.pdf(wo, wi, TransportMode::Radiance);
-    if (guide) d.guide = guide->pdf_square(d.square) * kInv4Pi;
-    return d;
-  }
-  float pdf(const DirectionPdfs& d) const {
-    return guide ? bsdf_fraction * d.bsdf + (1 - bsdf_fraction) * d.guide : d.bsdf;
-  }
-};
-
-// A direction sampled from the mixture.
-struct MixtureSample {
-  Vec3 wi;
-  float pdf = 0;       // the mixture's (the BSDF's alone without a guide)
-  DirectionPdfs pdfs;  // filled where the vertex is guidable
-  Rgb weight;          // f |cos| / pdf
-  // f |cos| / p_bsdf: what the weight would be had the BSDF alone been sampled (Russian roulette)
-  Rgb bsdf_weight;
-  bool specular = false;
-  float eta2 = 1;  // eta^2 of a sampled refraction (for Russian roulette)
-};
-
-std::optional<MixtureSample> sample_mixture(const Bsdf& bsdf, Vec3 wo, const Mixture& m,
-                                            float u_technique, float uc, Vec2 u) {
-  MixtureSample s;
-  if (m.guide && u_technique >= m.bsdf_fraction) {
-    // The sampled point's leaf density is the guide's density of the direction (the round trip
-    // through direction_to_square() agrees but within float rounding at leaf borders).
-    float guide_pdf;
-    const Vec2 square = m.guide->sample_square(u, &guide_pdf);
-    s.wi = square_to_direction(square);
-    s.pdfs = {square, bsdf.pdf(wo, s.wi, TransportMode::Radiance), guide_pdf * kInv4Pi};
-  } else {
-    const auto bs = bsdf.sample(wo, uc, u, TransportMode::Radiance);
-    if (!bs) return std::nullopt;
-    s.wi = bs->wi;
-    if (bs->is_transmission()) s.eta2 = sqr(bs->eta);
-    if (!m.guide) {
-      s.specular = bs->is_specular();
-      s.pdf = bs->pdf_is_proportional ? bsdf.pdf(wo, s.wi, TransportMode::Radiance) : bs->pdf;
-      s.weight = s.bsdf_weight = bs->f * (bsdf.abs_cos(s.wi) / bs->pdf);
-      if (m.guidable) s.pdfs = {direction_to_square(s.wi), s.pdf, 0.f};
-      return s;
-    }
-    s.pdfs = m.evaluate(bsdf, wo, s.wi);
-  }
-  s.pdf = m.pdf(s.pdfs);
-  if (!(s.pdf > 0)) return std::nullopt;
-  const Rgb f_cos = bsdf.f(wo, s.wi, TransportMode::Radiance) * bsdf.abs_cos(s.wi);
-  s.weight = f_cos / s.pdf;
-  s.bsdf_weight = s.pdfs.bsdf > 0 ? f_cos / s.pdfs.bsdf : Rgb(0.f);
-  return s;
-}
-
 // The mixture at a vertex at p: guided where the BSDF has neither delta nor near-specular lobes
-// and is not stochastic, with the distribution and selection probability of p's leaf on the
-// side the path arrived from (GuidingField::side_class of the geometric normal facing wo); its
-// records go to the leaf of p jittered by the leaf's size (the spatial box filter).
+// (layered BSDFs are guided whatever their coat: guided_mixture.h), with the distribution and
+// selection probability of p's leaf on the side the path arrived from (GuidingField::side_class of
+// the geometric normal facing wo); its records go to the leaf of p jittered by the leaf's size (the
+// spatial box filter).
 Mixture mixture_at(const GuidingField& field, const GuidingSettings& settings, bool learn,
                    const SurfaceInteraction& si, const Bsdf& bsdf, Pcg32& rng) {
   Mixture mix;
-  mix.guidable = !is_specular(bsdf.flags()) && !bsdf.is_delta() && !bsdf.stochastic();
+  mix.guidable = guidable_bsdf(bsdf);
   if (!mix.guidable) return mix;
   const Vec3 p = si.p;
   const int side = GuidingField::side_class(face_forward(si.ng, si.wo));
@@ -361,7 +286,8 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     beta *= s->weight;
     if (learn && mix.guidable) {
       (*vertex_counts)[mix.record_leaf] += uint32_t(record_stride_);
-      learning->add_vertex(mix, *s, beta);
+      // A layered BSDF's delta sample (its smooth coat) has no density to record.
+      if (!s->specular) learning->add_vertex(mix, *s, beta);
     }
     prev_pdf = s->pdf;
     specular_bounce = s->specular;

@@ -50,9 +50,9 @@ class CoatedConductorMaterial final : public Material {
     k = k / ieta;
     const Rgb albedo = clamp(p_.albedo->eval(ctx), 0.f, 1.f);
     const float g = clamp(p_.g->eval_float(ctx), -1.f, 1.f);
-    const auto* bxdf = arena.make<CoatedConductorBxDF>(
-        DielectricBxDF(ieta, coat), ConductorBxDF(metal, eta, k), p_.thickness, albedo, g,
-        p_.max_depth, p_.n_samples);
+    const auto* bxdf =
+        arena.make<CoatedConductorBxDF>(DielectricBxDF(ieta, coat), ConductorBxDF(metal, eta, k),
+                                        p_.thickness, albedo, g, p_.max_depth, p_.n_samples);
     return Bsdf(bxdf, si.shading, si.ng);
   }
   const char* name() const override { return "coatedconductor"; }

@@ -60,8 +60,7 @@ class ConductorBxDF final : public BxDF {
   }
 
   float pdf(Vec3 wo, Vec3 wi, TransportMode, Lobes lobes) const {
-    if (!has(lobes, Lobes::Reflection) || !same_hemisphere(wo, wi) ||
-        distrib_.effectively_smooth())
+    if (!has(lobes, Lobes::Reflection) || !same_hemisphere(wo, wi) || distrib_.effectively_smooth())
       return 0;
     Vec3 wm = wo + wi;
     if (length_squared(wm) == 0) return 0;

@@ -35,7 +35,6 @@
 namespace caustica {
 namespace layered {
 
-
 // Henyey-Greenstein phase function with pbrt-v4's conventions: wo and wi both point away from
 // the scattering point, so forward scattering (g > 0) peaks at wi = -wo.
 inline float henyey_greenstein(float cos_theta, float g) {

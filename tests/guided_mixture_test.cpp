@@ -1,6 +1,7 @@
-// guided-pt's mixture of BSDF sampling and the learned distribution (guided_mixture.h): for any
-// BSDF it guides, layered (stochastic) ones included, the mean sample weight over the mixture is
-// the BSDF's directional albedo, the same number its own sample weights estimate.
+// The mixtures of BSDF sampling and a learned distribution, guided-pt's (guided_mixture.h) and
+// guided-bpt/guided-vcm's (bidir/vertex_guides.h, both transport modes): for any BSDF they
+// guide, layered (stochastic) ones included, the mean sample weight over the mixture is the
+// BSDF's directional albedo, the same number its own sample weights estimate.
 #include "integrators/guided_mixture.h"
 
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 #include "core/rng.h"
 #include "core/warp.h"
 #include "geometry/interaction.h"
+#include "integrators/bidir/vertex_guides.h"
 #include "materials/materials.h"
 
 namespace caustica {
@@ -80,40 +82,60 @@ void expect_unbiased(const MaterialPtr& material, const char* name, bool f_brigh
   for (float theta : {15.f, 60.f}) {
     const float t = radians(theta);
     const Vec3 wo = kFrame.to_world(Vec3(std::sin(t) * 0.6f, std::sin(t) * 0.8f, std::cos(t)));
-    const int n = 200000;
-    Pcg32 rng_b(1, 2);
-    const Mean albedo = mean_of(n, [&](int) {
-      const float uc = rng_b.next_float();
-      const auto smp = s.bsdf.sample(wo, uc, rng_b.next_2d(), TransportMode::Radiance);
-      return smp ? double(smp->f.g * s.bsdf.abs_cos(smp->wi) / smp->pdf) : 0.0;
-    });
-    for (float a : {0.25f, 0.7f}) {
-      Mixture m;
-      m.guide = &guide;
-      m.bsdf_fraction = a;
-      m.guidable = true;
-      Pcg32 rng_m(3, 4);
-      const Mean mixed = mean_of(n, [&](int) {
-        const float ut = rng_m.next_float(), uc = rng_m.next_float();
-        const auto smp = sample_mixture(s.bsdf, wo, m, ut, uc, rng_m.next_2d());
-        return smp ? double(smp->weight.g) : 0.0;
+    const int n = 80000;
+    // The albedo each mode's sample weights estimate (the adjoint's differs).
+    Mean albedos[2];
+    for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance}) {
+      Pcg32 rng_b(1, 2);
+      albedos[int(mode)] = mean_of(n, [&](int) {
+        const float uc = rng_b.next_float();
+        const auto smp = s.bsdf.sample(wo, uc, rng_b.next_2d(), mode);
+        return smp ? double(smp->f.g * s.bsdf.abs_cos(smp->wi) / smp->pdf) : 0.0;
       });
-      const double tolerance =
-          4 * std::sqrt(sqr(albedo.standard_error) + sqr(mixed.standard_error)) + 1e-4;
-      if (!f_brighter) {
-        EXPECT_NEAR(mixed.mean, albedo.mean, tolerance)
-            << name << " theta " << theta << " a " << a << " (albedo " << albedo.mean << ")";
-        continue;
-      }
-      const double f_albedo = test::integrate_sphere(
-          [&](Vec3 wi) {
-            return double(s.bsdf.f(wo, wi, TransportMode::Radiance).g * s.bsdf.abs_cos(wi));
-          },
-          256, 512);
-      EXPECT_GT(f_albedo, albedo.mean + tolerance) << name;
-      EXPECT_GT(mixed.mean, albedo.mean - tolerance) << name << " theta " << theta << " a " << a;
-      EXPECT_LT(mixed.mean, f_albedo + tolerance) << name << " theta " << theta << " a " << a;
     }
+    for (float a : {0.25f, 0.7f})
+      for (bool bidirectional : {false, true}) {
+        Pcg32 rng_m(3, 4);
+        Mixture m;  // guided-pt's
+        m.guide = &guide;
+        m.bsdf_fraction = a;
+        m.guidable = true;
+        // guided-bpt / guided-vcm's, on the side of wo, for the subpaths of both modes.
+        bidir::VertexGuides g;
+        g.n = kFrame.n;
+        for (int mode = 0; mode < 2; ++mode) {
+          g.guides[mode][0] = &guide;
+          g.bsdf[mode][0] = a;
+        }
+        g.resolved = 0b0101;
+        const TransportMode mode =
+            bidirectional && a > 0.5f ? TransportMode::Importance : TransportMode::Radiance;
+        const Mean mixed = mean_of(n, [&](int) {
+          const float ut = rng_m.next_float(), uc = rng_m.next_float();
+          const Vec2 u = rng_m.next_2d();
+          if (bidirectional) {
+            const auto smp = bidir::sample_guided(s.bsdf, g, wo, mode, ut, uc, u);
+            return smp ? double(smp->weight.g) : 0.0;
+          }
+          const auto smp = sample_mixture(s.bsdf, wo, m, ut, uc, u);
+          return smp ? double(smp->weight.g) : 0.0;
+        });
+        SCOPED_TRACE(bidirectional ? "bidir::sample_guided" : "sample_mixture");
+        const Mean& albedo = albedos[int(mode)];
+        const double tolerance =
+            4 * std::sqrt(sqr(albedo.standard_error) + sqr(mixed.standard_error)) + 1e-4;
+        if (!f_brighter) {
+          EXPECT_NEAR(mixed.mean, albedo.mean, tolerance)
+              << name << " theta " << theta << " a " << a << " (albedo " << albedo.mean << ")";
+          continue;
+        }
+        const double f_albedo = test::integrate_sphere(
+            [&](Vec3 wi) { return double(s.bsdf.f(wo, wi, mode).g * s.bsdf.abs_cos(wi)); }, 256,
+            512);
+        EXPECT_GT(f_albedo, albedo.mean + tolerance) << name;
+        EXPECT_GT(mixed.mean, albedo.mean - tolerance) << name << " theta " << theta << " a " << a;
+        EXPECT_LT(mixed.mean, f_albedo + tolerance) << name << " theta " << theta << " a " << a;
+      }
   }
 }
 

@@ -72,8 +72,10 @@ bool BidirGuiding::end_pass_after(uint32_t iteration, double elapsed,
   return true;
 }
 
+// As guided-pt's (guidable_bsdf, guided_mixture.h): layered BSDFs are guided whatever their
+// coat (sample_guided weighs their walks), other BSDFs only without specular lobes.
 bool BidirGuiding::guidable(const Bsdf& bsdf) {
-  return !is_specular(bsdf.flags()) && !bsdf.is_delta() && !bsdf.stochastic();
+  return !bsdf.is_delta() && (bsdf.stochastic() || !is_specular(bsdf.flags()));
 }
 
 VertexGuides BidirGuiding::at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const {

@@ -18,7 +18,8 @@ std::optional<SubpathStep> scatter_subpath(const MisRules& rules, MisSums& mis,
     step.bsdf_pdf = gs->bsdf_pdf;
     step.guide_pdf = gs->guide_pdf;
     step.weight = gs->weight;
-    scatter_update(rules, mis, si, bsdf, si.wo, step.wi, mode, false,
+    step.specular = gs->specular;
+    scatter_update(rules, mis, si, bsdf, si.wo, step.wi, mode, step.specular,
                    guided_mis ? gs->pdf : gs->bsdf_pdf, mis_guides);
     beta *= gs->weight;
     rr_beta *= gs->bsdf_weight;
@@ -34,8 +35,9 @@ std::optional<SubpathStep> scatter_subpath(const MisRules& rules, MisSums& mis,
       bs->pdf_is_proportional ? direction_pdf(bsdf, mis_guides, si.wo, step.wi, mode) : bs->pdf;
   scatter_update(rules, mis, si, bsdf, si.wo, step.wi, mode, step.specular, pdf_fwd, mis_guides);
   const Rgb weight = bs->f * (bsdf.abs_cos(step.wi) / bs->pdf);
-  step.pdf = bs->pdf;
-  step.bsdf_pdf = bs->pdf;
+  // A layered BSDF's sample carries only the ratio f / pdf: its density is pdf()'s.
+  step.pdf = bs->pdf_is_proportional ? pdf_fwd : bs->pdf;
+  step.bsdf_pdf = step.pdf;
   step.weight = weight;
   beta *= weight;
   rr_beta *= weight;

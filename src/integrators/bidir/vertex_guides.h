@@ -47,10 +47,13 @@ struct VertexGuides {
   mutable uint8_t memoized = 0;
 
   static int side_of(Vec3 n, Vec3 w) { return dot(w, n) < 0 ? 1 : 0; }
+  // A (mode, side) marked resolved keeps what it holds (the tests set guides that way).
   const DirectionalQuadtree* guide(TransportMode mode, Vec3 wo) const {
-    if (!fields) return nullptr;
     const int side = side_of(n, wo);
-    if (!(resolved & (1u << (2 * int(mode) + side)))) resolve(mode, side);
+    if (!(resolved & (1u << (2 * int(mode) + side)))) {
+      if (!fields) return nullptr;
+      resolve(mode, side);
+    }
     return guides[int(mode)][side];
   }
   // Only after guide() of the same mode and side.
@@ -88,16 +91,20 @@ inline float direction_pdf(const Bsdf& bsdf, const VertexGuides& g, Vec3 wo, Vec
 // A direction sampled from the mixture of `mode` at a vertex with a guide for it.
 struct GuidedSample {
   Vec3 wi;
-  float pdf = 0;        // the mixture's
-  float bsdf_pdf = 0;   // the BSDF's alone
-  float guide_pdf = 0;  // the learned distribution's alone
-  Rgb weight;           // f |cos| / pdf
-  Rgb bsdf_weight;      // f |cos| / p_bsdf: the weight had the BSDF alone been sampled (roulette)
-  float eta = 1;        // of a sampled refraction, else 1
+  float pdf = 0;          // the mixture's
+  float bsdf_pdf = 0;     // the BSDF's alone
+  float guide_pdf = 0;    // the learned distribution's alone
+  Rgb weight;             // f |cos| / pdf
+  Rgb bsdf_weight;        // f |cos| / p_bsdf: the weight had the BSDF alone been sampled (roulette)
+  float eta = 1;          // of a sampled refraction, else 1
+  bool specular = false;  // a layered BSDF's delta sample (its smooth coat)
 };
 
 // u_technique picks the BSDF (below the BSDF fraction) or the guide; uc and u sample either.
 // Requires g.guide(mode, wo) (a vertex without one samples its BSDF as the unguided core does).
+// A layered (stochastic) BSDF's walk is weighted as guided-pt weighs it (guided_mixture.h): the
+// balance weights of its approximate density p~ keep the two techniques unbiased, and a delta
+// sample of a smooth coat, which only the BSDF makes, is divided by a.
 inline std::optional<GuidedSample> sample_guided(const Bsdf& bsdf, const VertexGuides& g, Vec3 wo,
                                                  TransportMode mode, float u_technique, float uc,
                                                  Vec2 u) {
@@ -109,6 +116,22 @@ inline std::optional<GuidedSample> sample_guided(const Bsdf& bsdf, const VertexG
     if (!bs) return std::nullopt;
     s.wi = bs->wi;
     if (bs->is_transmission()) s.eta = bs->eta;
+    if (bs->pdf_is_proportional) {
+      const Rgb walk = bs->f * (bsdf.abs_cos(s.wi) / bs->pdf);
+      s.bsdf_pdf = bsdf.pdf(wo, s.wi, mode);
+      s.bsdf_weight = walk;
+      if (bs->is_specular()) {
+        s.specular = true;
+        s.pdf = s.bsdf_pdf;
+        s.weight = walk / a;
+        return s;
+      }
+      s.guide_pdf = g.guide_pdf(mode, wo, s.wi);
+      s.pdf = a * s.bsdf_pdf + (1 - a) * s.guide_pdf;
+      if (!(s.pdf > 0) || walk.is_black()) return std::nullopt;
+      s.weight = walk * (s.bsdf_pdf / s.pdf);
+      return s;
+    }
     s.guide_pdf = g.guide_pdf(mode, wo, s.wi);
   } else {
     // The sampled point's leaf density is the guide's density of the direction (as guided-pt:

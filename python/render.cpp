@@ -67,6 +67,8 @@ IntegratorSettings integrator_settings(const LoadedScene& s, uint64_t seed,
       settings.bidir.radius_alpha = float(number_arg(name, value, 0, 1, true));
     } else if (name == "connections") {
       settings.bidir.connections = int(integer_arg(name, value, 1, 64));
+    } else if (name == "merge_mis_scale") {
+      settings.bidir.merge_mis_scale = float(number_arg(name, value, 0, 100, true));
     } else if (name == "adaptive_costs") {
       const std::string c = py::isinstance<py::str>(value) ? value.cast<std::string>() : "";
       if (c != "model" && c != "measured")
@@ -76,7 +78,7 @@ IntegratorSettings integrator_settings(const LoadedScene& s, uint64_t seed,
     } else {
       throw py::value_error("unknown option '" + name +
                             "'; valid: mis, max_depth, light_paths, radius, radius_alpha, "
-                            "connections, adaptive_costs");
+                            "connections, merge_mis_scale, adaptive_costs");
     }
   }
   const Camera& camera = s.scene->camera();
@@ -249,7 +251,9 @@ void add_render_functions(py::module_& m) {
       "light_paths (light subpaths per iteration, >= 1; default: one per pixel), radius "
       "(initial merge radius, > 0; default: from the scene size), radius_alpha (in (0, 1]; "
       "default 0.75), connections (light subpaths per camera vertex for bpt/vcm, 1..64), "
-      "adaptive_costs ('model' or 'measured', adaptive-vcm). None means not given. Unknown names "
+      "merge_mis_scale (the merges' count in the vcm/guided-vcm MIS weights, in (0, 100]; "
+      "default 1), adaptive_costs ('model' or 'measured', adaptive-vcm). None means not given. "
+      "Unknown names "
       "or bad values raise ValueError.\n"
       "Releases the GIL; Ctrl-C ends the render after its current iteration and raises "
       "KeyboardInterrupt.");

@@ -179,8 +179,8 @@ struct Key {
 std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& path, bool connect,
                                      bool merge, bool power, double light_paths, double radius,
                                      ScratchArena& arena, double raster_density = 1,
-                                     double connections = 1,
-                                     const BidirGuiding* guiding = nullptr) {
+                                     double connections = 1, const BidirGuiding* guiding = nullptr,
+                                     double merge_scale = 1) {
   const Light& light = *path.light;
   const bool finite = !light.is_infinite();
   const double pmf = scene.light_sampler().pmf(&light);
@@ -257,8 +257,8 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
     p[{false, k, 1}] = light_paths * prod(light_pdf, 0, k - 1);
   for (int j = 1; merge && j <= k - 1; ++j)
     if (!delta(j))
-      p[{true, j + 1, k + 1 - j}] =
-          light_paths * kPi * radius * radius * prod(light_pdf, 0, j) * prod(camera_pdf, j, k - 1);
+      p[{true, j + 1, k + 1 - j}] = merge_scale * light_paths * kPi * radius * radius *
+                                    prod(light_pdf, 0, j) * prod(camera_pdf, j, k - 1);
   double total = 0;
   for (auto& [key, v] : p) {
     v = power ? v * v : v;
@@ -277,6 +277,7 @@ struct Case {
   bool pixel_merges = true;  // false: a pixel of adaptive-vcm that does not merge
   bool guided = false;       // guided-bpt / guided-vcm: densities of trained guiding fields
   bool guide_camera = true, guide_light = true;  // which subpaths (--guiding-subpaths)
+  float merge_scale = 1;                         // --merge-mis-scale
 };
 
 // Fields of guided-bpt / guided-vcm trained on synthetic records: surface points hit by rays from
@@ -349,10 +350,10 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
     const float density = filter_densities ? 0.01f + 3.99f * rng.next_float() : 1.f;
     const auto weights =
         production_weights(scene, c.algorithm, c.heuristic, light_paths, radius, path, arena,
-                           density, c.connections, c.pixel_merges, guiding.get());
+                           density, c.connections, c.pixel_merges, guiding.get(), c.merge_scale);
     const auto oracle =
         oracle_weights(scene, path, connect, merge, c.heuristic == MisHeuristic::Power, light_paths,
-                       radius, arena, density, c.connections, guiding.get());
+                       radius, arena, density, c.connections, guiding.get(), c.merge_scale);
     if (oracle.empty() || !std::isfinite(oracle.begin()->second))
       continue;  // no technique can make it
     double sum = 0;
@@ -449,7 +450,14 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"cornell", BidirAlgorithm::GuidedVcm, MisHeuristic::Balance, 1024, 1, true, true, true,
              false},
         Case{"corners", BidirAlgorithm::GuidedVcm, MisHeuristic::Balance, 700, 1, true, true, false,
-             true}),
+             true},
+        // --merge-mis-scale: the merges' count scaled in the weights (renderer and oracle).
+        Case{"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Balance, 1024, 1, true, false,
+             true, true, 0.25f},
+        Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Power, 700, 2, true, false, true, true,
+             4.f},
+        Case{"cornell", BidirAlgorithm::GuidedVcm, MisHeuristic::Balance, 1024, 1, true, true, true,
+             true, 0.5f}),
     [](const auto& info) {
       std::string n =
           std::string(info.param.scene) + "_" + std::to_string(int(info.param.algorithm)) + "_" +
@@ -457,7 +465,10 @@ INSTANTIATE_TEST_SUITE_P(
           std::to_string(int(info.param.light_paths)) + "_c" +
           std::to_string(info.param.connections) + (info.param.pixel_merges ? "" : "_nomerge") +
           (info.param.guided ? "_guided" : "") + (info.param.guide_light ? "" : "_camera") +
-          (info.param.guide_camera ? "" : "_light");
+          (info.param.guide_camera ? "" : "_light") +
+          (info.param.merge_scale == 1
+               ? ""
+               : "_mergescale" + std::to_string(int(100 * info.param.merge_scale)));
       for (char& ch : n)
         if (ch == '-') ch = '_';
       return n;

@@ -48,3 +48,32 @@ TEST(BidirTechniques, ImagesSumToTheFinalImage) {
     std::filesystem::remove_all(dir);
   }
 }
+
+// --merge-mis-scale changes only how the techniques share a path (the merges' count in the
+// weights), never what they estimate: inside the furnace (radiance Le / (1 - a) everywhere, so
+// merging has no kernel bias) vcm stays unbiased whether merging is trusted 4x less or 4x more,
+// and the images differ from the balance heuristic's at the same seed.
+TEST(BidirMergeMisScale, WeightsChangeButTheFurnaceStaysExact) {
+  FurnaceParams p;
+  p.albedo = 0.5f;
+  p.emission = 1.5f;
+  auto scene = make_furnace_scene(p, 24, 24);
+  IntegratorSettings s;
+  s.max_depth = 200;
+  s.bidir.radius = 0.05f;
+  const Image balance = render_with(*scene, "vcm", 4, s).image;
+  for (float scale : {0.25f, 4.f}) {
+    s.bidir.merge_mis_scale = scale;
+    s.seed = 0;
+    const Image scaled = render_with(*scene, "vcm", 4, s).image;
+    double moved = 0;
+    for (size_t i = 0; i < scaled.pixel_count(); ++i)
+      moved += std::abs(scaled[i].average() - balance[i].average());
+    EXPECT_GT(moved / double(scaled.pixel_count()), 1e-3) << "scale " << scale << " was ignored";
+    const auto [m, se] = over_seeds(6, [&](uint64_t seed) {
+      s.seed = seed;
+      return pixel_stats(render_with(*scene, "vcm", 8, s).image).mean;
+    });
+    EXPECT_NEAR(m, p.expected_radiance(), 3 * se + 1e-5) << "scale " << scale;
+  }
+}

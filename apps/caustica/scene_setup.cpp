@@ -87,6 +87,10 @@ CLI::Option* add_shared_options(CheckedOptions& o, SharedOptions* s, const std::
          "Bidirectional: write one weighted image per technique to DIR");
   o.integer("--connections", &s->bidir.connections, 1, 64,
             "bpt / vcm: light subpaths each camera vertex connects to, 1..64 (default 1)");
+  o.number("--merge-mis-scale", &s->bidir.merge_mis_scale, 0, 100, true,
+           "vcm / guided-vcm: factor of the merges' sample count N pi r^2 in the MIS weights "
+           "only, in (0, 100] (default 1: the balance heuristic of Georgiev et al. 2012; below 1 "
+           "trusts merging less; the weights still sum to one; adaptive-vcm keeps 1)");
   o.choice("--adaptive-costs", &s->adaptive_costs, {"model", "measured"},
            "adaptive-vcm: price techniques with the fixed cost model (default; deterministic) or "
            "with costs measured on this machine while rendering (not reproducible)");

@@ -28,6 +28,12 @@ struct BidirSettings {
   float radius_alpha = 0.75f;  // r_i = r_1 i^((alpha - 1) / 2)
   std::string techniques_dir;  // if set, write one image per technique
   int connections = 1;         // bpt, vcm: light subpaths each camera vertex connects to
+  // vcm, guided-vcm: scales the merges' sample count N pi r^2 in the MIS weights only (1 = the
+  // balance heuristic of Georgiev et al. 2012). Any value keeps the weights summing to one;
+  // below 1 it trusts merging less, everywhere, which is the direction correlation-aware MIS
+  // (Grittmann et al. 2021) moves per vertex: merges share their light subpaths, so they are
+  // worth fewer than N independent samples. (bpm: every technique merges, the factor cancels.)
+  float merge_mis_scale = 1;
   // adaptive-vcm: price techniques with costs measured on this machine while rendering
   // (non-deterministic) instead of the fixed cost model.
   bool measured_costs = false;

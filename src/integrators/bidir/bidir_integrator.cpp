@@ -115,7 +115,10 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   counts.emitter = connect ? 1.f : 0.f;
   counts.light_trace = connect ? float(n) : 0.f;
   counts.connect = connect && n > 0 ? float(it.plan.connections) : 0.f;
-  counts.merge = tech_.merge ? kPi * it.radius * it.radius * float(n) : 0.f;
+  // --merge-mis-scale scales the merges' count in the weights only (adaptive-vcm predicts its
+  // candidates' variances under the balance heuristic's counts, so it keeps them).
+  const float merge_scale = tech_.adaptive ? 1.f : settings_.bidir.merge_mis_scale;
+  counts.merge = tech_.merge ? kPi * it.radius * it.radius * float(n) * merge_scale : 0.f;
   it.rules = MisRules(heuristic_, counts);
   it.rules_no_merge = it.rules.with_merging(false);
   it.rules_camera_only = MisRules(heuristic_, {counts.emitter, 0.f, 0.f, 0.f});

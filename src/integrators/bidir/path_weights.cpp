@@ -9,12 +9,10 @@
 
 namespace caustica::bidir {
 
-std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
-                                                MisHeuristic heuristic, float light_paths,
-                                                float radius, const ExplicitPath& path,
-                                                ScratchArena& arena, float raster_density,
-                                                int connections, bool pixel_merges,
-                                                const BidirGuiding* guiding) {
+std::vector<TechniqueWeight> production_weights(
+    const Scene& scene, BidirAlgorithm algorithm, MisHeuristic heuristic, float light_paths,
+    float radius, const ExplicitPath& path, ScratchArena& arena, float raster_density,
+    int connections, bool pixel_merges, const BidirGuiding* guiding, float merge_mis_scale) {
   const bool connect = algorithm != BidirAlgorithm::Bpm;
   const bool merge =
       algorithm != BidirAlgorithm::Bpt && algorithm != BidirAlgorithm::GuidedBpt && pixel_merges;
@@ -22,7 +20,7 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   counts.emitter = connect ? 1.f : 0.f;
   counts.light_trace = connect ? light_paths : 0.f;
   counts.connect = connect ? float(connections) : 0.f;
-  counts.merge = merge ? kPi * radius * radius * light_paths : 0.f;
+  counts.merge = merge ? kPi * radius * radius * light_paths * merge_mis_scale : 0.f;
   const MisRules rules(heuristic, counts);
   const Light& light = *path.light;
   const float pmf = scene.light_sampler().pmf(&light);

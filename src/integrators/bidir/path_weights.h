@@ -42,11 +42,13 @@ struct TechniqueWeight {
 // pixel_merges: false for a pixel of adaptive-vcm that does not merge.
 // guiding: the learned fields of guided-bpt / guided-vcm (their vertices' densities are the
 // guided mixtures'); nullptr: unguided.
+// merge_mis_scale: --merge-mis-scale, the factor of the merges' count N pi r^2 in the weights.
 std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
                                                 MisHeuristic heuristic, float light_paths,
                                                 float radius, const ExplicitPath& path,
                                                 ScratchArena& arena, float raster_density = 1.f,
                                                 int connections = 1, bool pixel_merges = true,
-                                                const BidirGuiding* guiding = nullptr);
+                                                const BidirGuiding* guiding = nullptr,
+                                                float merge_mis_scale = 1.f);
 
 }  // namespace caustica::bidir

@@ -54,9 +54,7 @@ TEST(BidirTechniques, ImagesSumToTheFinalImage) {
 // merging has no kernel bias) vcm stays unbiased whether merging is trusted 4x less or 4x more,
 // and the images differ from the balance heuristic's at the same seed.
 TEST(BidirMergeMisScale, WeightsChangeButTheFurnaceStaysExact) {
-  FurnaceParams p;
-  p.albedo = 0.5f;
-  p.emission = 1.5f;
+  const FurnaceParams p{0.5f, 1.5f};  // radiance 3
   auto scene = make_furnace_scene(p, 24, 24);
   IntegratorSettings s;
   s.max_depth = 200;

@@ -22,16 +22,31 @@ bool TrainingSchedule::guided() const {
 bool TrainingSchedule::starts_pass(uint32_t iteration, double elapsed) {
   if (iteration == 0) {
     *this = TrainingSchedule(spp_, seconds_);
-    pass_start_seconds_ = elapsed;
+    pass_start_seconds_ = last_seconds_ = elapsed;
     return false;
   }
-  if (phase_ == Phase::Rendering || iteration < pass_start_ + pass_length_) return false;
+  if (phase_ == Phase::Rendering) return false;
+  if (in_trial()) trial_iteration_seconds_.push_back(elapsed - last_seconds_);
+  last_seconds_ = elapsed;
+  if (iteration < pass_start_ + pass_length_) return false;
   ended_ = {pass_start_, pass_length_, pass_start_seconds_, elapsed - pass_start_seconds_};
   ended_phase_ = phase_;
   ++pass_;
   pass_start_ = iteration;
   pass_start_seconds_ = elapsed;
   return true;
+}
+
+double TrainingSchedule::trial_tau(double variance) {
+  std::vector<double>& d = trial_iteration_seconds_;
+  double tau = -1;
+  if (variance >= 0 && !d.empty()) {
+    std::nth_element(d.begin(), d.begin() + ptrdiff_t(d.size() / 2), d.end());
+    const double median = d[d.size() / 2];
+    if (median > 0) tau = variance * median * double(d.size());
+  }
+  d.clear();
+  return tau;
 }
 
 void TrainingSchedule::train_on() {
@@ -41,15 +56,14 @@ void TrainingSchedule::train_on() {
 }
 
 void TrainingSchedule::end_pass(double variance) {
-  const double tau_seconds = variance >= 0 && ended_.seconds > 0 ? variance * ended_.seconds : -1;
   if (ended_phase_ == Phase::TrialGuided) {
-    trial_tau_[1] = tau_seconds;
+    trial_tau_[1] = trial_tau(variance);
     phase_ = Phase::TrialUnguided;
     pass_length_ = ended_.length;
     return;
   }
   if (ended_phase_ == Phase::TrialUnguided) {
-    trial_tau_[0] = tau_seconds;
+    trial_tau_[0] = trial_tau(variance);
     // The early trial measures a field learned from 16 samples per pixel, which training will
     // improve, but training costs too: guiding goes on only where it already pays. (With a 1.1x
     // margin for guiding, cornell-glass 160x160 at 30 s kept it with unguided 1.05x as

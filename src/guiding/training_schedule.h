@@ -22,9 +22,10 @@
 // one, guided, to the end (per sample, the learned selection probability already falls back
 // to the BSDF where the guide does not help). With a time budget, guiding must also pay for its
 // time, which trials decide: one pass guided and one unguided of equal length, and the one
-// with the lower variance x seconds (the inverse of efficiency) wins. The first trial (8
-// iterations each) follows training pass 3: if guiding loses (training would cost more time on
-// top), rendering starts unguided at once (an easy scene stops paying for training early);
+// with the lower variance x seconds (the inverse of efficiency; the seconds of the median
+// iteration times the iterations, so that a stall of the machine does not decide) wins. The first
+// trial (8 iterations each) follows training pass 3: if guiding loses (training would cost more
+// time on top), rendering starts unguided at once (an easy scene stops paying for training early);
 // else training goes on and the render stays guided. Without that trial (training
 // stopped earlier), one follows training (half the last training pass each, at least 8). A
 // two-sample unguided pass 0 cannot decide this: its variance estimate misses the rare, bright
@@ -76,8 +77,8 @@ class TrainingSchedule {
 
   // For each completed training pass, V^_k as above (negative when unknown, and for pass 0).
   const std::vector<double>& predicted_final_variances() const { return predicted_; }
-  // The trial of a time budget: variance x seconds of its guided and unguided pass (negative
-  // until measured).
+  // The trial of a time budget: variance x seconds of its guided and unguided pass, the seconds
+  // as the median iteration's times the pass's iterations (negative until measured).
   double trial_guided_tau() const { return trial_tau_[1]; }
   double trial_unguided_tau() const { return trial_tau_[0]; }
 
@@ -87,6 +88,9 @@ class TrainingSchedule {
   static constexpr uint32_t kMinTrial = 8;         // iterations per trial pass, at least
   static constexpr size_t kEarlyTrialAfter = 3;    // time budgets: the first trial
   void stop_training(const char* reason);
+  // A trial pass's variance x seconds, its seconds the median iteration's times its iterations:
+  // a few slow iterations (another process, a page fault storm) do not decide the trial.
+  double trial_tau(double variance);
   void train_on();  // the next training pass
 
   int spp_ = 0;
@@ -99,6 +103,8 @@ class TrainingSchedule {
   uint32_t pass_start_ = 0;  // first iteration of the current pass
   uint32_t pass_length_ = 2;
   double pass_start_seconds_ = 0;
+  double last_seconds_ = 0;                      // when the last iteration ended
+  std::vector<double> trial_iteration_seconds_;  // the current trial pass's iterations
   struct Ended {
     uint32_t start = 0, length = 0;
     double start_seconds = 0, seconds = 0;

@@ -594,52 +594,47 @@ TEST(TrainingSchedule, TimeBudgetSwitchesGuidingOffWhenItDoesNotPay) {
   }
 }
 
-// Learning from a training pass (the field's end_pass) takes time between two passes, which
-// the clock gives to the first iteration of the pass after it: for the early trial, its guided
-// pass. Here each build takes as long as 20 iterations, and guided iterations cost what
-// unguided ones do with 1.2x lower variance: guiding must win the trial (timed by the pass's
-// wall seconds, the build made it lose).
-TEST(TrainingSchedule, TrialDoesNotPayForBuildingTheField) {
+// A time budget whose guided iterations cost what unguided ones do, with 1.2x lower variance,
+// and where `delay(s)` adds seconds after each iteration's own millisecond (or, with
+// `after_learning`, after a training pass ends, while the field learns): the finished schedule.
+template <typename Delay>
+TrainingSchedule schedule_with_delays(Delay&& delay, double after_learning = 0) {
   TrainingSchedule s(0, 10.0);
   double t = 0;
   for (uint32_t i = 0, start = 0; !s.final_pass() && i < 100000; ++i) {
     const bool was_guided = s.guided();
     if (s.starts_pass(i, t)) {
-      if (s.ended_learning()) t += 0.02;  // the field learns what the pass recorded
+      if (s.ended_learning()) t += after_learning;
       s.end_pass((was_guided ? 1.0 : 1.2) / double(i - start));
       start = i;
     }
-    t += 0.001;  // seconds per iteration, guided or not
+    t += 0.001 + delay(s);
   }
-  ASSERT_TRUE(s.final_pass());
-  EXPECT_TRUE(s.guided());
-  EXPECT_LT(s.trial_guided_tau(), s.trial_unguided_tau());
-  EXPECT_STRNE(s.reason(), "trial");
+  return s;
 }
 
-// The trial's seconds are its median iteration's times its iterations: one iteration of the
-// guided trial pass stalled for as long as 40 iterations (on door-ajar at 60 s, a guided trial
-// pass once took 3.1x its unguided one, against 1.6x in the next run) does not switch off
-// guiding that is 1.2x better per sample at equal cost.
-TEST(TrainingSchedule, TrialIsNotDecidedByOneStalledIteration) {
-  TrainingSchedule s(0, 10.0);
-  double t = 0;
+// A trial pass's seconds are its median iteration's times its iterations, so guiding that pays
+// wins its trial although (a) building the field after a training pass takes as long as 20
+// iterations, time the clock gives to the first iteration of the next pass (for the early
+// trial: its guided pass), or (b) one iteration of the guided trial pass stalls for as long as
+// 40 (on door-ajar at 60 s a guided trial pass once took 3.1x its unguided one, 1.6x in the
+// next run). Timed by the passes' wall seconds, guiding lost both.
+TEST(TrainingSchedule, TrialIsNotDecidedByABuildOrAStalledIteration) {
   bool stalled = false;
-  for (uint32_t i = 0, start = 0; !s.final_pass() && i < 100000; ++i) {
-    const bool was_guided = s.guided();
-    if (s.starts_pass(i, t)) {
-      s.end_pass((was_guided ? 1.0 : 1.2) / double(i - start));
-      start = i;
-    }
-    t += 0.001;
-    if (s.in_trial() && s.guided() && !stalled) {
-      t += 0.04;  // the stall
-      stalled = true;
-    }
-  }
+  const TrainingSchedule stall = schedule_with_delays([&](const TrainingSchedule& s) {
+    if (stalled || !s.in_trial() || !s.guided()) return 0.0;
+    stalled = true;
+    return 0.04;
+  });
+  const TrainingSchedule build = schedule_with_delays([](const TrainingSchedule&) { return 0.0; },
+                                                      /*after_learning=*/0.02);
   ASSERT_TRUE(stalled);
-  EXPECT_TRUE(s.guided());
-  EXPECT_LT(s.trial_guided_tau(), s.trial_unguided_tau());
+  for (const TrainingSchedule* s : {&stall, &build}) {
+    ASSERT_TRUE(s->final_pass());
+    EXPECT_TRUE(s->guided());
+    EXPECT_LT(s->trial_guided_tau(), s->trial_unguided_tau());
+    EXPECT_STRNE(s->reason(), "trial");
+  }
 }
 
 // Renders `spp` samples per pixel with the render loop (which gives the integrator its budget)

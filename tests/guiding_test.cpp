@@ -469,6 +469,30 @@ TEST(Guiding, InverseVarianceCombinationWeightsPasses) {
   EXPECT_NEAR(passes[2].variance, 4.0, 1e-9);
 }
 
+// A pass's variance comes with its standard error as a mean over pixels: pixel variances of the
+// mean 1 and 4 (samples 0, 2 and 0, 4) give V = 2.5 and an error of sqrt(4.5 / 2) = 1.5 (their
+// unbiased spread 4.5 over two pixels); equal pixels give 0, one sample per pixel none.
+TEST(Guiding, InverseVarianceReportsTheErrorOfAPassVariance) {
+  InverseVarianceCombiner c(2, 1);
+  c.add(0, Rgb(0.f));
+  c.add(1, Rgb(0.f));
+  c.end_iteration();
+  EXPECT_LT(c.passes().back().variance_error, 0);
+  c.add(0, Rgb(2.f));
+  c.add(1, Rgb(4.f));
+  c.end_iteration();
+  EXPECT_NEAR(c.passes().back().variance, 2.5, 1e-9);
+  EXPECT_NEAR(c.passes().back().variance_error, 1.5, 1e-9);
+  c.end_pass();
+  for (float v : {0.f, 2.f}) {
+    c.add(0, Rgb(v));
+    c.add(1, Rgb(v));
+    c.end_iteration();
+  }
+  EXPECT_NEAR(c.passes().back().variance_error, 0.0, 1e-12);
+  EXPECT_NEAR(c.passes().front().variance_error, 1.5, 1e-9);
+}
+
 // The current pass split over two processes (each rendered some of its iterations) and summed
 // exactly gives one process's combination bit for bit (MPI ranks: sums_over_ranks). Values
 // chosen so that a double sum in another order rounds differently; a firefly far above the
@@ -635,6 +659,73 @@ TEST(TrainingSchedule, TrialIsNotDecidedByABuildOrAStalledIteration) {
     EXPECT_LT(s->trial_guided_tau(), s->trial_unguided_tau());
     EXPECT_STRNE(s->reason(), "trial");
   }
+}
+
+// A time budget of `seconds` whose iterations take 1 ms guided or not, and whose passes report
+// the variance of per-sample variance `per_sample(guided, round)` (round: the trial round the
+// pass belongs to, -1 outside trials) with a relative standard error `rel_error` (negative:
+// none): the finished schedule.
+template <typename PerSample>
+TrainingSchedule schedule_with_variances(PerSample&& per_sample, double rel_error,
+                                         double seconds = 10) {
+  TrainingSchedule s(0, seconds);
+  double t = 0;
+  int round = 0;
+  for (uint32_t i = 0, start = 0; !s.final_pass() && i < 100000; ++i) {
+    const bool was_guided = s.guided(), was_trial = s.in_trial();
+    if (s.starts_pass(i, t)) {
+      const double v = per_sample(was_guided, was_trial ? round : -1) / double(i - start);
+      s.end_pass(v, rel_error < 0 ? -1.0 : rel_error * v);
+      if (was_trial && !was_guided) ++round;
+      start = i;
+    }
+    t += 0.001;
+  }
+  return s;
+}
+
+// A trial is a sequential test. A difference of 2x against errors of 10% decides in one round;
+// a near tie (5%, well inside twice the ratio's error) renders the four rounds, and the pooled
+// rounds decide either way; without errors, or without the time for another round (a 90 ms
+// budget: three rounds of 16 ms would be left), the first round decides.
+TEST(TrainingSchedule, NearTiesRenderMoreTrialRounds) {
+  for (const auto& [guided, unguided, rel_error, seconds, rounds] :
+       {std::tuple{1.0, 2.0, 0.1, 10.0, 1}, std::tuple{1.0, 1.05, 0.1, 10.0, 4},
+        std::tuple{1.05, 1.0, 0.1, 10.0, 4}, std::tuple{1.0, 1.05, -1.0, 10.0, 1},
+        std::tuple{1.0, 1.05, 0.1, 0.09, 1}}) {
+    const TrainingSchedule s = schedule_with_variances(
+        [&](bool g, int) { return g ? guided : unguided; }, rel_error, seconds);
+    const std::string what = std::to_string(guided) + " " + std::to_string(unguided) + " " +
+                             std::to_string(rel_error) + " " + std::to_string(seconds);
+    ASSERT_TRUE(s.final_pass()) << what;
+    EXPECT_EQ(s.trial_rounds(), rounds) << what;
+    EXPECT_EQ(s.guided(), guided < unguided) << what;
+    EXPECT_NEAR(s.trial_guided_tau(), guided * 0.001, 1e-12) << what;
+    EXPECT_NEAR(s.trial_unguided_tau(), unguided * 0.001, 1e-12) << what;
+    if (guided > unguided) {
+      EXPECT_STREQ(s.reason(), "trial") << what;
+      EXPECT_EQ(s.rendering_from(), 16 + 16 * rounds) << what;  // training 16, then the rounds
+    }
+  }
+}
+
+// The rounds pool: a first round where guiding looks 1.2x worse per sample (at equal cost), then
+// rounds where it is 0.6x: after three rounds the pooled variances (0.8 against 1) differ by more
+// than twice the ratio's error (0.22 against 0.17 in the log) and guiding wins. The first round
+// alone (no errors) switches it off. A schedule that kept only the last round's variance would
+// decide after the second (2 x 0.14 < 0.51) with tau 0.6 ms.
+TEST(TrainingSchedule, TrialRoundsArePooled) {
+  auto per_sample = [](bool g, int round) { return g ? (round <= 0 ? 1.2 : 0.6) : 1.0; };
+  const TrainingSchedule pooled = schedule_with_variances(per_sample, 0.1);
+  EXPECT_EQ(pooled.trial_rounds(), 3);
+  EXPECT_TRUE(pooled.guided());
+  EXPECT_NEAR(pooled.trial_guided_tau(), 0.8 * 0.001, 1e-12);
+  EXPECT_NEAR(pooled.trial_log_ratio_error(),
+              0.1 * std::hypot(std::sqrt(1.44 + 0.36 + 0.36) / 2.4, 1 / std::sqrt(3.0)), 1e-9);
+  const TrainingSchedule first = schedule_with_variances(per_sample, -1);
+  EXPECT_EQ(first.trial_rounds(), 1);
+  EXPECT_FALSE(first.guided());
+  EXPECT_STREQ(first.reason(), "trial");
 }
 
 // Renders `spp` samples per pixel with the render loop (which gives the integrator its budget)

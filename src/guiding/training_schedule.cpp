@@ -1,6 +1,7 @@
 #include "guiding/training_schedule.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 
 namespace caustica {
@@ -26,7 +27,7 @@ bool TrainingSchedule::starts_pass(uint32_t iteration, double elapsed) {
     return false;
   }
   if (phase_ == Phase::Rendering) return false;
-  if (in_trial()) trial_iteration_seconds_.push_back(elapsed - last_seconds_);
+  if (in_trial()) trial_[phase_ == Phase::TrialGuided].seconds.push_back(elapsed - last_seconds_);
   last_seconds_ = elapsed;
   if (iteration < pass_start_ + pass_length_) return false;
   ended_ = {pass_start_, pass_length_, pass_start_seconds_, elapsed - pass_start_seconds_};
@@ -37,16 +38,50 @@ bool TrainingSchedule::starts_pass(uint32_t iteration, double elapsed) {
   return true;
 }
 
-double TrainingSchedule::trial_tau(double variance) {
-  std::vector<double>& d = trial_iteration_seconds_;
-  double tau = -1;
-  if (variance >= 0 && !d.empty()) {
-    std::nth_element(d.begin(), d.begin() + ptrdiff_t(d.size() / 2), d.end());
-    const double median = d[d.size() / 2];
-    if (median > 0) tau = variance * median * double(d.size());
+double TrainingSchedule::TrialArm::median_seconds() const {
+  if (seconds.empty()) return 0;
+  std::vector<double> d = seconds;
+  std::nth_element(d.begin(), d.begin() + ptrdiff_t(d.size() / 2), d.end());
+  return d[d.size() / 2];
+}
+
+double TrainingSchedule::TrialArm::tau() const {
+  const double median = median_seconds();
+  return samples > 0 && moment >= 0 && median > 0 ? moment / samples * median : -1;
+}
+
+double TrainingSchedule::TrialArm::relative_error() const {
+  return error_known && moment > 0 ? std::sqrt(error2) / moment : -1;
+}
+
+void TrainingSchedule::add_round(TrialArm& arm, double variance, double variance_error) {
+  const double n = ended_.length;
+  if (variance < 0 || arm.moment < 0) {
+    arm.moment = -1;
+    return;
   }
-  d.clear();
-  return tau;
+  arm.samples += n;
+  arm.moment += variance * n * n;
+  arm.error2 += variance_error < 0 ? 0.0 : (variance_error * n * n) * (variance_error * n * n);
+  arm.error_known = arm.error_known && variance_error >= 0;
+}
+
+bool TrainingSchedule::trial_decided() const {
+  if (trial_tau_[0] < 0 || trial_tau_[1] < 0 || trial_log_error_ < 0) return true;
+  if (trial_rounds_ >= kMaxTrialRounds) return true;
+  if (std::abs(std::log(trial_tau_[0] / trial_tau_[1])) >= kTrialZ * trial_log_error_) return true;
+  // Another round must leave most of the budget to the render.
+  const double round =
+      double(ended_.length) * (trial_[0].median_seconds() + trial_[1].median_seconds());
+  return seconds_ - last_seconds_ < 4 * round;
+}
+
+void TrainingSchedule::start_trial(uint32_t length) {
+  phase_ = Phase::TrialGuided;
+  pass_length_ = length;
+  trial_[0] = trial_[1] = TrialArm();
+  trial_rounds_ = 0;
+  trial_log_error_ = -1;
 }
 
 void TrainingSchedule::train_on() {
@@ -55,15 +90,25 @@ void TrainingSchedule::train_on() {
   pass_length_ = training_pass_ < 31 ? 1u << training_pass_ : 1u << 31;
 }
 
-void TrainingSchedule::end_pass(double variance) {
+void TrainingSchedule::end_pass(double variance, double variance_error) {
   if (ended_phase_ == Phase::TrialGuided) {
-    trial_tau_[1] = trial_tau(variance);
+    add_round(trial_[1], variance, variance_error);
     phase_ = Phase::TrialUnguided;
     pass_length_ = ended_.length;
     return;
   }
   if (ended_phase_ == Phase::TrialUnguided) {
-    trial_tau_[0] = trial_tau(variance);
+    add_round(trial_[0], variance, variance_error);
+    ++trial_rounds_;
+    trial_tau_[0] = trial_[0].tau();
+    trial_tau_[1] = trial_[1].tau();
+    const double eu = trial_[0].relative_error(), eg = trial_[1].relative_error();
+    trial_log_error_ = eu >= 0 && eg >= 0 ? std::sqrt(eu * eu + eg * eg) : -1;
+    if (!trial_decided()) {  // a near tie: another round of both
+      phase_ = Phase::TrialGuided;
+      pass_length_ = ended_.length;
+      return;
+    }
     // The early trial measures a field learned from 16 samples per pixel, which training will
     // improve, but training costs too: guiding goes on only where it already pays. (With a 1.1x
     // margin for guiding, cornell-glass 160x160 at 30 s kept it with unguided 1.05x as
@@ -112,8 +157,7 @@ void TrainingSchedule::end_pass(double variance) {
   }
   if (!samples && k == kEarlyTrialAfter && !early_trial_) {
     early_trial_ = true;
-    phase_ = Phase::TrialGuided;
-    pass_length_ = kMinTrial;
+    start_trial(kMinTrial);
     return;
   }
   train_on();
@@ -127,8 +171,7 @@ void TrainingSchedule::stop_training(const char* reason) {
     rendering_guided_ = true;
     return;
   }
-  phase_ = Phase::TrialGuided;
-  pass_length_ = std::max(kMinTrial, ended_.length / 2);
+  start_trial(std::max(kMinTrial, ended_.length / 2));
 }
 
 }  // namespace caustica

@@ -23,7 +23,14 @@
 // to the BSDF where the guide does not help). With a time budget, guiding must also pay for its
 // time, which trials decide: one pass guided and one unguided of equal length, and the one
 // with the lower variance x seconds (the inverse of efficiency; the seconds of the median
-// iteration times the iterations, so that a stall of the machine does not decide) wins. The first
+// iteration times the iterations, so that a stall of the machine does not decide) wins. A trial
+// is a sequential test: where the passes' variances come with their standard errors and the
+// two efficiencies differ by less than twice the error of their ratio, it renders another
+// round (one more guided and one more unguided pass of the same length) and decides on the
+// pooled rounds, at most kMaxTrialRounds of them. One round of 8 iterations each measured each
+// variance within +-10%: door-ajar (320x240, where guiding is 1.5x as efficient) lost its early
+// trial at one seed in ten (0.93x) and cornell-glass (160x160, guiding 1.17x worse) won it at
+// one in ten (1.08x). The first
 // trial (8 iterations each) follows training pass 3: if guiding loses (training would cost more
 // time on top), rendering starts unguided at once (an easy scene stops paying for training early);
 // else training goes on and the render stays guided. Without that trial (training
@@ -53,8 +60,9 @@ class TrainingSchedule {
   // iteration 0). `elapsed` is the seconds since the render began (time budgets only).
   bool starts_pass(uint32_t iteration, double elapsed);
   // After a pass has ended (starts_pass returned true): its variance (V_k, the variance of its
-  // pixel mean; negative: unknown). Decides what the pass now starting does.
-  void end_pass(double variance);
+  // pixel mean; negative: unknown) and that estimate's standard error (negative: unknown, and a
+  // trial then decides on its first round). Decides what the pass now starting does.
+  void end_pass(double variance, double variance_error = -1);
 
   int pass() const { return pass_; }
   // Whether the current pass records what it sees (training passes).
@@ -79,19 +87,39 @@ class TrainingSchedule {
   const std::vector<double>& predicted_final_variances() const { return predicted_; }
   // The trial of a time budget: variance x seconds of its guided and unguided pass, the seconds
   // as the median iteration's times the pass's iterations (negative until measured).
+  // Pooled over the trial's rounds, per iteration of one sample per pixel.
   double trial_guided_tau() const { return trial_tau_[1]; }
   double trial_unguided_tau() const { return trial_tau_[0]; }
+  // The rounds the last trial took (0 before any), and the standard error of the log of its
+  // efficiency ratio (negative: unknown).
+  int trial_rounds() const { return trial_rounds_; }
+  double trial_log_ratio_error() const { return trial_log_error_; }
 
  private:
   enum class Phase { Training, TrialGuided, TrialUnguided, Rendering };
   static constexpr size_t kFirstVarianceStop = 5;  // the variance rule from training pass 5 on
   static constexpr uint32_t kMinTrial = 8;         // iterations per trial pass, at least
   static constexpr size_t kEarlyTrialAfter = 3;    // time budgets: the first trial
+  static constexpr int kMaxTrialRounds = 4;
+  static constexpr double kTrialZ = 2;  // a difference of kTrialZ standard errors decides
   void stop_training(const char* reason);
-  // A trial pass's variance x seconds, its seconds the median iteration's times its iterations:
-  // a few slow iterations (another process, a page fault storm) do not decide the trial.
-  double trial_tau(double variance);
-  void train_on();  // the next training pass
+  void start_trial(uint32_t length);
+  // One arm (guided or unguided) of a trial, pooled over its rounds.
+  struct TrialArm {
+    double samples = 0;             // iterations
+    double moment = 0;              // sum over rounds of V_r n_r^2 (n_r: its iterations)
+    double error2 = 0;              // sum over rounds of (E_r n_r^2)^2 (E_r: V_r's standard error)
+    bool error_known = true;        // every round came with its error
+    std::vector<double> seconds;    // of each iteration
+    double median_seconds() const;  // 0 without iterations
+    // Per-sample variance times the median iteration's seconds: a few slow iterations
+    // (another process, a page fault storm) do not decide the trial. Negative: unknown.
+    double tau() const;
+    double relative_error() const;  // of tau's variance factor; negative: unknown
+  };
+  void add_round(TrialArm& arm, double variance, double variance_error);
+  bool trial_decided() const;  // after an unguided trial pass: no further round is needed
+  void train_on();             // the next training pass
 
   int spp_ = 0;
   double seconds_ = 0;
@@ -103,8 +131,8 @@ class TrainingSchedule {
   uint32_t pass_start_ = 0;  // first iteration of the current pass
   uint32_t pass_length_ = 2;
   double pass_start_seconds_ = 0;
-  double last_seconds_ = 0;                      // when the last iteration ended
-  std::vector<double> trial_iteration_seconds_;  // the current trial pass's iterations
+  double last_seconds_ = 0;  // when the last iteration ended
+  TrialArm trial_[2];        // [guided]
   struct Ended {
     uint32_t start = 0, length = 0;
     double start_seconds = 0, seconds = 0;
@@ -114,6 +142,8 @@ class TrainingSchedule {
   const char* reason_ = "";
   std::vector<double> predicted_;
   double trial_tau_[2] = {-1, -1};  // [guided]
+  int trial_rounds_ = 0;
+  double trial_log_error_ = -1;
 };
 
 }  // namespace caustica

@@ -37,26 +37,31 @@ Rgb InverseVarianceCombiner::mean(size_t i, double n) const {
   return Rgb(float(from_fixed(m[0]) / n), float(from_fixed(m[1]) / n), float(from_fixed(m[2]) / n));
 }
 
-double InverseVarianceCombiner::current_variance() const {
+InverseVarianceCombiner::Pass InverseVarianceCombiner::current_pass() const {
   const uint32_t samples = this->samples();
-  if (samples < 2) return -1;
+  if (samples < 2) return {samples, -1, -1};
   const double n = samples;
   const size_t pixels = size_t(width_) * size_t(height_);
-  double sum = 0;
+  double sum = 0, sum2 = 0;
   for (size_t i = 0; i < pixels; ++i) {
     const FixedSum* m = &current_[i * kSumsPerPixel];
     const double y =
         0.2126 * from_fixed(m[0]) + 0.7152 * from_fixed(m[1]) + 0.0722 * from_fixed(m[2]);
     // Unbiased sample variance of the luminance, over n for the variance of the mean.
     const double y2 = std::ldexp(from_fixed(m[3]), kSquareShift);
-    sum += std::max(0.0, y2 - y * y / n) / (n - 1) / n;
+    const double v = std::max(0.0, y2 - y * y / n) / (n - 1) / n;
+    sum += v;
+    sum2 += v * v;
   }
-  return sum / double(pixels);
+  const double p = double(pixels), mean = sum / p;
+  const double spread = pixels > 1 ? std::max(0.0, sum2 / p - mean * mean) * p / (p - 1) : 0.0;
+  return {samples, mean, std::sqrt(spread / p)};
 }
 
 void InverseVarianceCombiner::end_pass() {
-  const double v = current_variance();
-  completed_.push_back({samples(), v});
+  const Pass pass = current_pass();
+  const double v = pass.variance;
+  completed_.push_back(pass);
   if (v >= 0) {
     const double w = inverse(v), total = weight_ + w, n = samples();
     for (size_t i = 0; i < combined_.size(); ++i)
@@ -71,7 +76,7 @@ void InverseVarianceCombiner::clear_current() {
 }
 
 Image InverseVarianceCombiner::image() const {
-  const double v = current_variance();
+  const double v = current_pass().variance;
   if (v < 0 && weight_ == 0) return Image();
   Image out(width_, height_);
   const double w = v < 0 ? 0 : inverse(v), total = weight_ + w, n = samples();
@@ -85,7 +90,7 @@ Image InverseVarianceCombiner::image() const {
 
 std::vector<InverseVarianceCombiner::Pass> InverseVarianceCombiner::passes() const {
   std::vector<Pass> all = completed_;
-  if (samples() > 0) all.push_back({samples(), current_variance()});
+  if (samples() > 0) all.push_back(current_pass());
   return all;
 }
 

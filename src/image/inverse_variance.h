@@ -50,6 +50,9 @@ class InverseVarianceCombiner {
   struct Pass {
     uint32_t samples;  // per pixel
     double variance;   // V_k; negative: no estimate (one sample)
+    // The standard error of V_k as a mean over independent pixels (their spread over sqrt of
+    // their count): how far another run's V_k would likely be. Negative without an estimate.
+    double variance_error = -1;
   };
   // Completed passes, then the current one.
   std::vector<Pass> passes() const;
@@ -64,7 +67,8 @@ class InverseVarianceCombiner {
   static constexpr size_t kSumsPerPixel = 4;  // r, g, b, squared luminance
 
  private:
-  double current_variance() const;  // V of the current pass; negative without an estimate
+  // V of the current pass and its standard error; negative without an estimate.
+  Pass current_pass() const;
   uint32_t samples() const { return current_.empty() ? 0 : uint32_t(current_.back()); }
   // The current pass's mean of pixel i.
   Rgb mean(size_t i, double n) const;

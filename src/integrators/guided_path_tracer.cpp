@@ -186,7 +186,8 @@ void GuidedPathTracer::end_pass_after(uint32_t iteration) {
   if (!schedule_.starts_pass(iteration + 1, seconds_since_start())) return;
   const bool learned = schedule_.ended_learning();
   const int k = schedule_.ended_training_pass();
-  schedule_.end_pass(passes_.passes().back().variance);
+  const InverseVarianceCombiner::Pass ended = passes_.passes().back();
+  schedule_.end_pass(ended.variance, ended.variance_error);
   if (learned) field_.end_pass(k);
   passes_.end_pass();
   pass_end_seconds_.push_back(seconds_since_start());

@@ -22,6 +22,7 @@ inline void report_passes(const InverseVarianceCombiner& combiner, bool inverse_
     const double end = k < ends.size() ? ends[k] : now;
     passes.push_back({{"spp", all[k].samples},
                       {"variance", all[k].variance},
+                      {"variance_error", all[k].variance_error},
                       {"seconds", end > begin ? end - begin : 0.0}});
   }
   g["passes"] = passes;
@@ -34,9 +35,12 @@ inline void report_schedule(const TrainingSchedule& s, nlohmann::json& g) {
   g["training_passes"] = s.training_passes();
   g["rendering_from_iteration"] = s.rendering_from();
   g["training_stopped_by"] = s.reason();
-  if (s.trial_guided_tau() >= 0 || s.trial_unguided_tau() >= 0)
+  if (s.trial_guided_tau() >= 0 || s.trial_unguided_tau() >= 0) {
     g["trial_variance_seconds"] = {{"guided", s.trial_guided_tau()},
                                    {"unguided", s.trial_unguided_tau()}};
+    g["trial_rounds"] = s.trial_rounds();
+    g["trial_log_ratio_error"] = s.trial_log_ratio_error();
+  }
   if (s.final_pass()) g["rendering_guided"] = s.guided();
   g["predicted_final_variances"] = s.predicted_final_variances();
 }

@@ -27,7 +27,8 @@
 // is a sequential test: where the passes' variances come with their standard errors and the
 // two efficiencies differ by less than twice the error of their ratio, it renders another
 // round (one more guided and one more unguided pass of the same length) and decides on the
-// pooled rounds, at most kMaxTrialRounds of them. One round of 8 iterations each measured each
+// pooled rounds, at most kMaxTrialRounds of them and only while the time left holds eight
+// more. One round of 8 iterations each measured each
 // variance within +-10%: door-ajar (320x240, where guiding is 1.5x as efficient) lost its early
 // trial at one seed in ten (0.93x) and cornell-glass (160x160, guiding 1.17x worse) won it at
 // one in ten (1.08x). The first
@@ -102,6 +103,7 @@ class TrainingSchedule {
   static constexpr size_t kEarlyTrialAfter = 3;    // time budgets: the first trial
   static constexpr int kMaxTrialRounds = 4;
   static constexpr double kTrialZ = 2;  // a difference of kTrialZ standard errors decides
+  static constexpr double kTrialRoundsInRest = 8;  // another round: the time left holds 8 rounds
   void stop_training(const char* reason);
   void start_trial(uint32_t length);
   // One arm (guided or unguided) of a trial, pooled over its rounds.

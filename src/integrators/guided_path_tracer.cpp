@@ -154,7 +154,7 @@ void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, 
   if (iteration == 0) schedule_.starts_pass(0, seconds_since_start());
   if (!schedule_.learning()) {  // rendering: sampling only
     trace_camera_paths(scene, iteration, film);
-    passes_.end_iteration();
+    if (!film_is_the_image()) passes_.end_iteration();
     end_pass_after(iteration);
     return;
   }
@@ -206,8 +206,12 @@ void GuidedPathTracer::finish(const Scene& scene, Film& film) {
                        [&](Vec3 p, int side) { return &field_.sampling(field_.leaf_at(p, side)); });
 }
 
+bool GuidedPathTracer::film_is_the_image() const {
+  return !settings_.guiding.inverse_variance || (schedule_.final_pass() && !schedule_.guided());
+}
+
 Image GuidedPathTracer::image(const Film& film) const {
-  if (!settings_.guiding.inverse_variance) return film.image();
+  if (film_is_the_image()) return film.image();
   Image combined = passes_.image();
   return combined.empty() ? film.image() : combined;
 }
@@ -218,9 +222,9 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
   const bool learn =
       schedule_.learning() && (sample.pixel + sample.iteration) % record_stride_ == 0;
   const bool guided = schedule_.guided();
-  if (!learn && !guided) {  // an unguided rendering pass: exactly pt's estimator, and as fast
+  if (!learn && !guided) {  // an unguided pass: exactly pt's estimator
     const Rgb L = unguided_.radiance(scene, sample.ray, rng, arena);
-    passes_.add(sample.pixel, L * sample.filter_weight);
+    if (!film_is_the_image()) passes_.add(sample.pixel, L * sample.filter_weight);
     return L;
   }
   // Rendering passes and unrecorded pixels learn nothing: no per-thread buffers are looked up.
@@ -315,8 +319,7 @@ void GuidedPathTracer::report(nlohmann::json& stats) const {
   g["record_pixel_stride_last"] = record_stride_;
   g["radiance_samples_recorded"] = recorded_;
   g["mean_bsdf_fraction"] = field_.mean_bsdf_fraction();
-  report_passes(passes_, settings_.guiding.inverse_variance, pass_end_seconds_,
-                seconds_since_start(), g);
+  report_passes(passes_, !film_is_the_image(), pass_end_seconds_, seconds_since_start(), g);
   if (!views_.is_null()) g["views"] = views_;
   stats["guiding"] = g;
 }

@@ -42,6 +42,9 @@
 // noisy passes count little, and no sample is thrown away. A pass with one sample per pixel has
 // no variance estimate and weight 0 (with two iterations or fewer, the plain average is shown).
 // With --guiding-combine equal every iteration counts the same (unbiased; the film's average).
+// So does a time budget whose trial switched guiding off: the rest is pt's estimator into the
+// film alone, as fast as `pt` (the passes' exact per-sample moments cost a few percent of a
+// cornell-glass iteration), and its few training iterations count as much as the others.
 //
 // Memory: a training iteration keeps its records until they are splatted; when they would
 // exceed kMaxRecords, the next iteration records one pixel in k (every pixel in turn), each
@@ -99,6 +102,9 @@ class GuidedPathTracer final : public CameraPathIntegrator {
   // ended, the field learns what it recorded, and the combiner folds it (at the end of a pass,
   // not the start of the next, so that shared_iteration() knows what the next one does).
   void end_pass_after(uint32_t iteration);
+  // The image is the film's average, and the current pass needs no moments: --guiding-combine
+  // equal, or the unguided rendering pass after a lost trial.
+  bool film_is_the_image() const;
 
   IntegratorSettings settings_;
   PathTracer unguided_;  // renders when guiding did not pay (with --time: the schedule's trials)

@@ -32,10 +32,12 @@
 // variance within +-10%: door-ajar (320x240, where guiding is 1.5x as efficient) lost its early
 // trial at one seed in ten (0.93x) and cornell-glass (160x160, guiding 1.17x worse) won it at
 // one in ten (1.08x). The first
-// trial (8 iterations each) follows training pass 3: if guiding loses (training would cost more
-// time on top), rendering starts unguided at once (an easy scene stops paying for training early);
-// else training goes on and the render stays guided. Without that trial (training
-// stopped earlier), one follows training (half the last training pass each, at least 8). A
+// trial (8 iterations each) follows training pass 3: if guiding clearly loses (training would
+// cost more time on top), rendering starts unguided at once (an easy scene stops paying for
+// training early); if it clearly wins, training goes on and the render stays guided; a tie
+// (no clear difference after its rounds) trains on, and a trial after training decides, on
+// the better field. Without a decisive early trial (a tie, or training stopped earlier), one
+// follows training (half the last training pass each, at least 8). A
 // two-sample unguided pass 0 cannot decide this: its variance estimate misses the rare, bright
 // paths that dominate scenes such as door-ajar (2 spp measured 32 per sample there, 43 over the
 // whole unguided render). Without a budget (an integrator driven iteration by iteration) training
@@ -83,6 +85,9 @@ class TrainingSchedule {
   // Why training stopped: "budget" (too little left for another pass), "variance" (V^ rose)
   // or "trial" (guiding lost the early trial); empty while training.
   const char* reason() const { return reason_; }
+  // The early trial's verdict: "won" (the render stays guided), "lost" (unguided at once),
+  // "tie" (no clear difference: training goes on and a trial after it decides); empty before.
+  const char* early_trial() const { return early_verdict_; }
 
   // For each completed training pass, V^_k as above (negative when unknown, and for pass 0).
   const std::vector<double>& predicted_final_variances() const { return predicted_; }
@@ -142,6 +147,7 @@ class TrainingSchedule {
   int64_t rendering_from_ = -1;
   bool rendering_guided_ = true;
   const char* reason_ = "";
+  const char* early_verdict_ = "";
   std::vector<double> predicted_;
   double trial_tau_[2] = {-1, -1};  // [guided]
   int trial_rounds_ = 0;

@@ -39,6 +39,7 @@ inline void report_schedule(const TrainingSchedule& s, nlohmann::json& g) {
     g["trial_variance_seconds"] = {{"guided", s.trial_guided_tau()},
                                    {"unguided", s.trial_unguided_tau()}};
     g["trial_rounds"] = s.trial_rounds();
+    g["early_trial"] = s.early_trial();
     g["trial_log_ratio_error"] = s.trial_log_ratio_error();
   }
   if (s.final_pass()) g["rendering_guided"] = s.guided();

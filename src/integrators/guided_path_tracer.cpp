@@ -152,6 +152,7 @@ void GuidedPathTracer::prepare(const Scene& scene, Film& film) {
 
 void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, Film& film) {
   if (iteration == 0) schedule_.starts_pass(0, seconds_since_start());
+  iterations_ = iteration + 1;
   if (!schedule_.learning()) {  // rendering: sampling only
     trace_camera_paths(scene, iteration, film);
     if (!film_is_the_image()) passes_.end_iteration();
@@ -320,6 +321,17 @@ void GuidedPathTracer::report(nlohmann::json& stats) const {
   g["radiance_samples_recorded"] = recorded_;
   g["mean_bsdf_fraction"] = field_.mean_bsdf_fraction();
   report_passes(passes_, !film_is_the_image(), pass_end_seconds_, seconds_since_start(), g);
+  if (settings_.guiding.inverse_variance && film_is_the_image() &&
+      schedule_.rendering_from() >= 0) {
+    // The unguided rest after a lost trial went to the film alone: no variance of its own.
+    const double begin = pass_end_seconds_.empty() ? 0.0 : pass_end_seconds_.back();
+    int64_t before = 0;
+    for (const InverseVarianceCombiner::Pass& p : passes_.passes()) before += p.samples;
+    g["passes"].push_back({{"spp", int64_t(iterations_) - before},
+                           {"variance", -1.0},
+                           {"variance_error", -1.0},
+                           {"seconds", std::max(0.0, seconds_since_start() - begin)}});
+  }
   if (!views_.is_null()) g["views"] = views_;
   stats["guiding"] = g;
 }

@@ -127,6 +127,7 @@ class GuidedPathTracer final : public CameraPathIntegrator {
   // Written by estimate(): one writer per pixel at a time.
   mutable InverseVarianceCombiner passes_;
   std::vector<double> pass_end_seconds_;  // when each completed pass ended (statistics)
+  uint32_t iterations_ = 0;               // rendered so far (statistics)
 };
 
 }  // namespace caustica

@@ -208,12 +208,14 @@ void BidirIntegrator::next_event(const Scene& scene, const MisRules& rules, cons
   const Vec2 u = rng.next_2d();
   const auto d = sample_direct_light(scene, v.si, v.bsdf, u_light, u);
   if (!d) return;
+  // The shadow ray before the MIS terms: an occluded light costs no densities (a coated
+  // BSDF's are random walks). The same contributions are made.
+  if (scene.occluded(d->shadow)) return;
   const TechniqueTerms terms =
       terms_next_event(rules, *d->light, d->pmf, d->ls, v.si, v.bsdf, v.mis, v.guides);
   const float w = terms.weight(rules.counts());
   const Rgb value = v.beta * d->f * d->ls.radiance * (w / (d->pmf * d->ls.pdf_w));
   if (value.is_black()) return;
-  if (scene.occluded(d->shadow)) return;
   acc.add(false, 1, v.depth + 1, value, &terms);
 }
 
@@ -286,12 +288,13 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
         light_bsdf.f(v.wo, -dir, TransportMode::Importance) * light_bsdf.abs_cos(dir);
     if (f_light.is_black()) continue;
     ++acc.work.connections;
+    // The shadow ray before the MIS terms, as for next event estimation.
+    if (scene.occluded(spawn_ray_between(si, light_si))) continue;
     const TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si,
                                                   bsdf, cv.mis, rebuilt.guides, cv.guides);
     const float w = terms.weight(rules.counts());
     const Rgb value = beta * v.throughput * f_camera * f_light * (w / dist2);
     if (value.is_black()) continue;
-    if (scene.occluded(spawn_ray_between(si, light_si))) continue;
     acc.add(false, v.depth + 1, depth + 1, value, &terms,
             own ? AdaptivePlan::Share::OwnLightPath : AdaptivePlan::Share::RandomLightPath);
   }

@@ -212,13 +212,12 @@ class BidirIntegrator final : public CameraPathIntegrator {
                                   LightChunk& chunk) const;
   // Splats a lens connection landing at `raster` to every pixel whose filter support holds it:
   // value_of(w) is the estimate with MIS weight w, terms_of(rules, raster_density) the pixel's
-  // MIS terms. Returns whether any splat was recorded (the caller then traces the shadow ray and
-  // drops them with drop_splats_from() if it is blocked).
+  // MIS terms. Returns whether any splat was recorded. The caller has traced the shadow ray
+  // first: a blocked connection costs no densities or terms.
   template <typename ValueOf, typename TermsOf>
   bool splat_lens_connection(const Camera& camera, const Iteration& it, Vec2 raster,
                              uint32_t technique, const ValueOf& value_of, const TermsOf& terms_of,
                              LightChunk& chunk) const;
-  static void drop_splats_from(size_t first, LightChunk& chunk);
   // t = 1: the light vertex seen through a lens point; splat recorded in the chunk. Returns
   // the connection's unweighted estimate (0 when blocked), what the guiding of light subpaths
   // learns from.

@@ -242,11 +242,6 @@ bool BidirIntegrator::splat_lens_connection(const Camera& camera, const Iteratio
   return chunk.splats.size() > first_splat;
 }
 
-void BidirIntegrator::drop_splats_from(size_t first, LightChunk& chunk) {
-  chunk.splats.resize(first);
-  if (chunk.splat_terms.size() > first) chunk.splat_terms.resize(first);
-}
-
 void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Iteration& it,
                                                  const Light& light, float pmf,
                                                  const LightLeSample& le, uint64_t path,
@@ -264,18 +259,17 @@ void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Itera
   // with pdf_w the lens point's solid-angle density at the light point).
   const float scale = lens.cos_at_vertex * cs->importance * float(camera.pixel_count()) /
                       (cs->pdf_w * float(it.plan.light_paths) * pos_pdf);
-  const size_t first_splat = chunk.splats.size();
-  const bool splatted = splat_lens_connection(
+  // The shadow ray before the splats and their MIS terms (up to 16 pixels under a wide filter).
+  const Vec3 o =
+      le.p + face_forward(le.n, cs->wi) * (1e-4f * std::max(1.f, max_component(abs(le.p))));
+  if (scene.occluded({o, cs->p_lens - o, 1.f - 1e-4f})) return;
+  splat_lens_connection(
       camera, it, cs->raster, TechniqueImages::key(false, 1, 1),
       [&](float w) { return radiance * (scale * w); },
       [&](const MisRules& rules, float raster_density) {
         return terms_light_origin_to_camera(rules, lens, pos_pdf, raster_density);
       },
       chunk);
-  if (!splatted) return;
-  const Vec3 o =
-      le.p + face_forward(le.n, cs->wi) * (1e-4f * std::max(1.f, max_component(abs(le.p))));
-  if (scene.occluded({o, cs->p_lens - o, 1.f - 1e-4f})) drop_splats_from(first_splat, chunk);
 }
 
 Rgb BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
@@ -292,7 +286,9 @@ Rgb BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
   // MIS-weighted against its own camera technique (raster density pdf(r - c_p)).
   const float scale =
       cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(it.plan.light_paths));
-  const size_t first_splat = chunk.splats.size();
+  // The shadow ray before the lens geometry's densities (a coated BSDF's reverse density is a
+  // random walk) and the splats' MIS terms: the same splats are made.
+  if (scene.occluded(si.spawn_ray_to(cs->p_lens))) return Rgb(0.f);
   const LensConnection lens = lens_connection(camera, si, bsdf, si.wo, cs->p_lens, guides);
   const bool splatted = splat_lens_connection(
       camera, it, cs->raster, TechniqueImages::key(false, depth + 1, 1),
@@ -301,12 +297,7 @@ Rgb BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
         return terms_light_to_camera(rules, lens, mis, raster_density);
       },
       chunk);
-  if (!splatted) return Rgb(0.f);
-  if (scene.occluded(si.spawn_ray_to(cs->p_lens))) {
-    drop_splats_from(first_splat, chunk);
-    return Rgb(0.f);
-  }
-  return beta * f * scale;
+  return splatted ? beta * f * scale : Rgb(0.f);
 }
 
 }  // namespace caustica::bidir

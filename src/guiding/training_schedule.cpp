@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <string_view>
 
 namespace caustica {
 
@@ -67,10 +66,13 @@ void TrainingSchedule::add_round(TrialArm& arm, double variance, double variance
   arm.error_known = arm.error_known && variance_error >= 0;
 }
 
+bool TrainingSchedule::trial_is_clear() const {
+  if (trial_tau_[0] <= 0 || trial_tau_[1] <= 0 || trial_log_error_ < 0) return true;
+  return std::abs(std::log(trial_tau_[0] / trial_tau_[1])) >= kTrialZ * trial_log_error_;
+}
+
 bool TrainingSchedule::trial_decided() const {
-  if (trial_tau_[0] < 0 || trial_tau_[1] < 0 || trial_log_error_ < 0) return true;
-  if (trial_rounds_ >= kMaxTrialRounds) return true;
-  if (std::abs(std::log(trial_tau_[0] / trial_tau_[1])) >= kTrialZ * trial_log_error_) return true;
+  if (trial_is_clear() || trial_rounds_ >= kMaxTrialRounds) return true;
   // Another round must cost little of what is left (guided-vcm on door-ajar at 60 s: a round of
   // 8 + 8 iterations takes 9 s, with 40 s left).
   const double round =
@@ -113,8 +115,7 @@ void TrainingSchedule::end_pass(double variance, double variance_error) {
     }
     const bool guided_wins =
         !(trial_tau_[0] >= 0 && trial_tau_[1] >= 0 && trial_tau_[0] < trial_tau_[1]);
-    const bool clear = trial_log_error_ < 0 || std::abs(std::log(trial_tau_[0] / trial_tau_[1])) >=
-                                                   kTrialZ * trial_log_error_;
+    const bool clear = trial_is_clear();
     if (rendering_from_ >= 0) {  // the trial after training decides
       phase_ = Phase::Rendering;
       rendering_guided_ = guided_wins;
@@ -126,6 +127,7 @@ void TrainingSchedule::end_pass(double variance, double variance_error) {
     // (320x240, 60 s, seed 8) tied after four rounds (guided 1.008x unguided; per sample 1.6x
     // better, each iteration 1.55x the time), lost, and ended 1.27x worse than pt, where the
     // trained field renders 2.9x better per sample at 1.4x the time.
+    early_won_ = clear && guided_wins;
     early_verdict_ = !clear ? "tie" : guided_wins ? "won" : "lost";
     if (clear && !guided_wins) {
       reason_ = "trial";
@@ -175,7 +177,7 @@ void TrainingSchedule::end_pass(double variance, double variance_error) {
 void TrainingSchedule::stop_training(const char* reason) {
   reason_ = reason;
   rendering_from_ = pass_start_;
-  if (spp_ > 0 || std::string_view(early_verdict_) == "won") {  // no time to weigh, or it paid
+  if (spp_ > 0 || early_won_) {  // no time to weigh, or guiding clearly won the early trial
     phase_ = Phase::Rendering;
     rendering_guided_ = true;
     return;

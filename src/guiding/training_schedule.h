@@ -125,8 +125,11 @@ class TrainingSchedule {
     double relative_error() const;  // of tau's variance factor; negative: unknown
   };
   void add_round(TrialArm& arm, double variance, double variance_error);
-  bool trial_decided() const;  // after an unguided trial pass: no further round is needed
-  void train_on();             // the next training pass
+  // After an unguided trial pass: the efficiencies differ by kTrialZ errors of their ratio (or
+  // the errors are unknown), and whether no further round is needed.
+  bool trial_is_clear() const;
+  bool trial_decided() const;
+  void train_on();  // the next training pass
 
   int spp_ = 0;
   double seconds_ = 0;
@@ -148,6 +151,7 @@ class TrainingSchedule {
   bool rendering_guided_ = true;
   const char* reason_ = "";
   const char* early_verdict_ = "";
+  bool early_won_ = false;
   std::vector<double> predicted_;
   double trial_tau_[2] = {-1, -1};  // [guided]
   int trial_rounds_ = 0;

@@ -64,10 +64,9 @@ bool BidirGuiding::end_pass_after(uint32_t iteration, double elapsed,
   const bool learned = schedule_.ended_learning();
   const int k = schedule_.ended_training_pass();
   const std::vector<InverseVarianceCombiner::Pass> all = passes.passes();
-  if (all.empty())
-    schedule_.end_pass(-1.0);
-  else
-    schedule_.end_pass(all.back().variance, all.back().variance_error);
+  const InverseVarianceCombiner::Pass ended =
+      all.empty() ? InverseVarianceCombiner::Pass{0, -1} : all.back();
+  schedule_.end_pass(ended.variance, ended.variance_error);
   if (learned) {
     radiance_.end_pass(k);
     importance_.end_pass(k);

@@ -22,20 +22,20 @@ class TrowbridgeReitz {
   bool effectively_smooth() const { return std::max(alpha_x_, alpha_y_) < 1e-3f; }
 
   // Microfacet normal density D(wm) (projected-area normalised: integral of D cos = 1).
+  // tan^2(theta) cos^2(phi) is x^2 / z^2 and tan^2(theta) sin^2(phi) is y^2 / z^2 for a unit
+  // vector: pbrt-v4's expressions without the square root and the divisions of sin(theta).
   float D(Vec3 wm) const {
-    const float tan2 = tan2_theta(wm);
-    if (std::isinf(tan2)) return 0;
-    const float cos4 = sqr(cos2_theta(wm));
-    if (cos4 < 1e-16f) return 0;
-    const float e = tan2 * (sqr(cos_phi(wm) / alpha_x_) + sqr(sin_phi(wm) / alpha_y_));
+    const float cos2 = cos2_theta(wm), cos4 = sqr(cos2);
+    if (cos4 < 1e-16f) return 0;  // grazing, and tan(theta) infinite at cos = 0
+    const float e = (sqr(wm.x / alpha_x_) + sqr(wm.y / alpha_y_)) / cos2;
     return 1 / (kPi * alpha_x_ * alpha_y_ * cos4 * sqr(1 + e));
   }
-  // Smith's auxiliary function.
+  // Smith's auxiliary function (0 where tan(theta) is infinite, as pbrt-v4's).
   float lambda(Vec3 w) const {
-    const float tan2 = tan2_theta(w);
-    if (std::isinf(tan2)) return 0;
-    const float alpha2 = sqr(cos_phi(w) * alpha_x_) + sqr(sin_phi(w) * alpha_y_);
-    return (std::sqrt(1 + alpha2 * tan2) - 1) / 2;
+    const float cos2 = cos2_theta(w);
+    if (cos2 == 0) return 0;
+    const float alpha2_tan2 = (sqr(w.x * alpha_x_) + sqr(w.y * alpha_y_)) / cos2;
+    return (std::sqrt(1 + alpha2_tan2) - 1) / 2;
   }
   float G1(Vec3 w) const { return 1 / (1 + lambda(w)); }
   // Height-correlated masking-shadowing.

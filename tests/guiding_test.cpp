@@ -618,23 +618,45 @@ TEST(TrainingSchedule, TimeBudgetSwitchesGuidingOffWhenItDoesNotPay) {
   }
 }
 
-// A time budget whose guided iterations cost what unguided ones do, with 1.2x lower variance,
-// and where `delay(s)` adds seconds after each iteration's own millisecond (or, with
-// `after_learning`, after a training pass ends, while the field learns): the finished schedule.
-template <typename Delay>
-TrainingSchedule schedule_with_delays(Delay&& delay, double after_learning = 0) {
-  TrainingSchedule s(0, 10.0);
+// A time budget of `seconds` whose iterations take 1 ms guided or not, plus `delay(s)` seconds
+// after each (and `after_learning` after a training pass ends, while the field learns), and
+// whose passes report the per-sample variance `per_sample(guided, round)` (round: the trial
+// round the pass belongs to, -1 outside trials) with a relative standard error `rel_error`
+// (negative: none): the finished schedule.
+template <typename PerSample, typename Delay>
+TrainingSchedule drive_schedule(PerSample&& per_sample, double rel_error, double seconds,
+                                Delay&& delay, double after_learning = 0) {
+  TrainingSchedule s(0, seconds);
   double t = 0;
+  int round = 0;
   for (uint32_t i = 0, start = 0; !s.final_pass() && i < 100000; ++i) {
-    const bool was_guided = s.guided();
+    const bool was_guided = s.guided(), was_trial = s.in_trial();
     if (s.starts_pass(i, t)) {
       if (s.ended_learning()) t += after_learning;
-      s.end_pass((was_guided ? 1.0 : 1.2) / double(i - start));
+      const double v = per_sample(was_guided, was_trial ? round : -1) / double(i - start);
+      s.end_pass(v, rel_error < 0 ? -1.0 : rel_error * v);
+      if (was_trial && !was_guided) ++round;
       start = i;
     }
     t += 0.001 + delay(s);
   }
   return s;
+}
+
+// Guided iterations as costly as unguided ones with 1.2x lower variance, no errors, and the
+// delays as above.
+template <typename Delay>
+TrainingSchedule schedule_with_delays(Delay&& delay, double after_learning = 0) {
+  return drive_schedule([](bool guided, int) { return guided ? 1.0 : 1.2; }, -1, 10.0, delay,
+                        after_learning);
+}
+
+// Per-sample variances and their errors as above, no delays.
+template <typename PerSample>
+TrainingSchedule schedule_with_variances(PerSample&& per_sample, double rel_error,
+                                         double seconds = 10) {
+  return drive_schedule(per_sample, rel_error, seconds,
+                        [](const TrainingSchedule&) { return 0.0; });
 }
 
 // A trial pass's seconds are its median iteration's times its iterations, so guiding that pays
@@ -659,29 +681,6 @@ TEST(TrainingSchedule, TrialIsNotDecidedByABuildOrAStalledIteration) {
     EXPECT_LT(s->trial_guided_tau(), s->trial_unguided_tau());
     EXPECT_STRNE(s->reason(), "trial");
   }
-}
-
-// A time budget of `seconds` whose iterations take 1 ms guided or not, and whose passes report
-// the variance of per-sample variance `per_sample(guided, round)` (round: the trial round the
-// pass belongs to, -1 outside trials) with a relative standard error `rel_error` (negative:
-// none): the finished schedule.
-template <typename PerSample>
-TrainingSchedule schedule_with_variances(PerSample&& per_sample, double rel_error,
-                                         double seconds = 10) {
-  TrainingSchedule s(0, seconds);
-  double t = 0;
-  int round = 0;
-  for (uint32_t i = 0, start = 0; !s.final_pass() && i < 100000; ++i) {
-    const bool was_guided = s.guided(), was_trial = s.in_trial();
-    if (s.starts_pass(i, t)) {
-      const double v = per_sample(was_guided, was_trial ? round : -1) / double(i - start);
-      s.end_pass(v, rel_error < 0 ? -1.0 : rel_error * v);
-      if (was_trial && !was_guided) ++round;
-      start = i;
-    }
-    t += 0.001;
-  }
-  return s;
 }
 
 // A trial is a sequential test. A difference of 2x against errors of 10% decides in one round;

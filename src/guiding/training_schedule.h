@@ -23,16 +23,15 @@
 // to the BSDF where the guide does not help). With a time budget, guiding must also pay for its
 // time, which trials decide: one pass guided and one unguided of equal length, and the one
 // with the lower variance x seconds (the inverse of efficiency; the seconds of the median
-// iteration times the iterations, so that a stall of the machine does not decide) wins. A trial
-// is a sequential test: where the passes' variances come with their standard errors and the
-// two efficiencies differ by less than twice the error of their ratio, it renders another
-// round (one more guided and one more unguided pass of the same length) and decides on the
-// pooled rounds, at most kMaxTrialRounds of them and only while the time left holds eight
-// more. One round of 8 iterations each measured each
-// variance within +-10%: door-ajar (320x240, where guiding is 1.5x as efficient) lost its early
-// trial at one seed in ten (0.93x) and cornell-glass (160x160, guiding 1.17x worse) won it at
-// one in ten (1.08x). The first
-// trial (8 iterations each) follows training pass 3: if guiding clearly loses (training would
+// iteration, so that a stall of the machine does not decide) wins. A trial is a sequential
+// test: where the passes' variances come with their standard errors and the two efficiencies
+// differ by less than twice the error of their ratio, it renders another round (one more
+// guided and one more unguided pass of the same length) and decides on the pooled rounds, at
+// most kMaxTrialRounds of them and only while the time left holds eight more. One round of 8
+// iterations each measured each variance within +-10%: door-ajar (320x240, where guiding is
+// 1.5x as efficient) lost its early trial at one seed in ten (0.93x) and cornell-glass
+// (160x160, guiding 1.17x worse) won it at one in ten (1.08x). The first trial (8 iterations
+// each) follows training pass 3: if guiding clearly loses (training would
 // cost more time on top), rendering starts unguided at once (an easy scene stops paying for
 // training early); if it clearly wins, training goes on and the render stays guided; a tie
 // (no clear difference after its rounds) trains on, and a trial after training decides, on
@@ -91,9 +90,8 @@ class TrainingSchedule {
 
   // For each completed training pass, V^_k as above (negative when unknown, and for pass 0).
   const std::vector<double>& predicted_final_variances() const { return predicted_; }
-  // The trial of a time budget: variance x seconds of its guided and unguided pass, the seconds
-  // as the median iteration's times the pass's iterations (negative until measured).
-  // Pooled over the trial's rounds, per iteration of one sample per pixel.
+  // The last trial of a time budget, guided and unguided: the per-sample variance pooled over
+  // its rounds times the median iteration's seconds (negative until measured).
   double trial_guided_tau() const { return trial_tau_[1]; }
   double trial_unguided_tau() const { return trial_tau_[0]; }
   // The rounds the last trial took (0 before any), and the standard error of the log of its

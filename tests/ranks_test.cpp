@@ -27,6 +27,21 @@ TEST(FixedSum, ConvertsExactlyAboveTheResolutionAndClampsTheRange) {
   EXPECT_NEAR(from_fixed(to_fixed(1e-15)), 1e-15, 0x1p-64);
 }
 
+// The two-part conversion is the plain one, FixedSum(v 2^64) truncated toward zero, bit for bit,
+// over magnitudes from below the resolution to just under the clamp (2^-68 .. 2^31), both signs.
+TEST(FixedSum, ConversionIsTheTruncatedScaledValue) {
+  uint64_t state = 777;
+  for (int i = 0; i < 20000; ++i) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    const double mantissa = 1 + double(state >> 11) * 0x1p-53;
+    const double v = std::ldexp(mantissa, int(state % 99) - 68) * (i % 2 ? -1 : 1);
+    __extension__ const FixedSum plain = FixedSum(v * 0x1p64);
+    ASSERT_TRUE(to_fixed(v) == plain) << v;
+  }
+  for (double v : {0.0, -0.0, 1.0, -1.0, 0x1p31, -0x1p31, 0x1p31 - 0.5, 0x1p-64, -0x1p-65})
+    EXPECT_TRUE(to_fixed(v) == FixedSum(v * 0x1p64)) << v;
+}
+
 // Values of many magnitudes, where double addition in two groupings gives two answers.
 std::vector<double> awkward_values() {
   std::vector<double> v;

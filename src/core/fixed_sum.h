@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 
 namespace caustica {
 
@@ -24,9 +25,15 @@ inline constexpr double kFixedSumMaxValue = 2147483648.0;  // 2^31
 
 inline FixedSum to_fixed(double v) {
   v = v < -kFixedSumMaxValue ? -kFixedSumMaxValue : (v > kFixedSumMaxValue ? kFixedSumMaxValue : v);
-  // Scaling by a power of two is exact (no overflow below 2^95; a subnormal scales up exactly),
-  // the same as std::ldexp(v, 64) without the call; then truncation.
-  return FixedSum(v * 0x1p64);
+  // trunc(v 2^64) without the libgcc call that a double -> __int128 conversion is (1% of a path
+  // tracer's profile): the integer part and the fraction (exact: a - trunc(a)) scaled exactly
+  // by 2^64, each by one hardware conversion to 64 bits; the same value bit for bit.
+  const bool negative = v < 0;
+  const double a = negative ? -v : v;  // [0, 2^31]
+  const uint64_t whole = uint64_t(a);
+  const uint64_t fraction = uint64_t((a - double(whole)) * 0x1p64);  // < 2^64
+  const FixedSum magnitude = (FixedSum(whole) << 64) | FixedSum(fraction);
+  return negative ? -magnitude : magnitude;
 }
 
 // Correctly rounded to the nearest double (libgcc's __floattidf), then scaled exactly.

@@ -131,6 +131,37 @@ TEST(Guiding, SampledDensityIsThePdfAtTheSample) {
   }
 }
 
+// Quadrants without energy, and one whose probability rounds to zero in float, are never
+// sampled and have density 0: every sample's density is positive, and the density is that of
+// the sampling (its integral is 1 and it is 0 exactly where nothing is drawn).
+TEST(Guiding, EmptyQuadrantsAreNeitherSampledNorDense) {
+  DirectionalQuadtree t;
+  t.record({0.25f, 0.25f}, 1.0);    // quadrant 0
+  t.record({0.75f, 0.25f}, 1e-30);  // quadrant 1: a share that rounds to 0
+  t.record({0.3f, 0.2f}, 1.0);      // two more in quadrant 0, so that it refines
+  t.record({0.1f, 0.45f}, 2.0);
+  t.propagate();
+  size_t budget = 1000;
+  DirectionalQuadtree d = t.refined(0.01, 8, &budget, 1.0);
+  for (Vec2 p : {Vec2(0.3f, 0.2f), Vec2(0.1f, 0.45f), Vec2(0.2f, 0.1f)}) d.record(p, 1.0);
+  d.propagate();
+  ASSERT_GT(d.depth(), 1);
+  EXPECT_EQ(d.pdf_square({0.75f, 0.25f}), 0.f) << "the rounded-away quadrant";
+  EXPECT_EQ(d.pdf_square({0.75f, 0.75f}), 0.f);
+  Pcg32 rng(5, 6);
+  for (int i = 0; i < 100000; ++i) {
+    float pdf = 0;
+    const Vec2 p = d.sample_square(rng.next_2d(), &pdf);
+    ASSERT_GT(pdf, 0.f) << p.x << " " << p.y;
+    ASSERT_TRUE(p.x < 0.5f && p.y < 0.5f) << p.x << " " << p.y;
+  }
+  double integral = 0;
+  constexpr int kN = 512;
+  for (int i = 0; i < kN; ++i)
+    for (int j = 0; j < kN; ++j) integral += d.pdf_square(Vec2((i + 0.5f) / kN, (j + 0.5f) / kN));
+  EXPECT_NEAR(integral / (kN * kN), 1.0, 1e-5);
+}
+
 // Trained on radiance concentrated in a cone, the learned density is much higher in the cone
 // than outside, and the cone's probability tends to its share of the energy as the quadtree
 // refines (smaller rho): leaves straddling the cone's rim spread its energy outside.

@@ -1,7 +1,9 @@
 #include "guiding/directional_quadtree.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <stdexcept>
 
 #include "core/math.h"
 
@@ -129,27 +131,54 @@ void DirectionalQuadtree::propagate() {
   for (size_t i = nodes_.size(); i-- > 0;)
     for (int q = 0; q < 4; ++q)
       if (const uint32_t c = nodes_[i].child[q]) nodes_[i].energy[q] = float(sum(nodes_[c].energy));
-  factors_.clear();  // factor() computes while the vector is shorter than nodes_
-  std::vector<std::array<float, 4>> factors(nodes_.size());
-  for (uint32_t i = 0; i < nodes_.size(); ++i)
-    for (int q = 0; q < 4; ++q) factors[i][q] = factor(i, q);
-  factors_ = std::move(factors);
+  if (nodes_.size() > SamplingNode::kIndexMask)
+    throw std::length_error("a directional quadtree of more than 2^28 nodes");
+  // Breadth first: the sampling layout's node i is nodes_[order[i]]; a node's inner quadrants
+  // take the next free indices, in quadrant order.
+  sampling_.assign(nodes_.size(), SamplingNode());
+  std::vector<uint32_t> order(nodes_.size());
+  uint32_t next = 1;
+  for (size_t i = 0; i < nodes_.size(); ++i) {
+    const Node& n = nodes_[order[i]];
+    SamplingNode& s = sampling_[i];
+    const std::array<float, 4>& e = n.energy;
+    const double total = sum(e), left = double(e[0]) + e[2];
+    if (total > 0) {
+      s.p_left = float(left / total);
+      for (int ix = 0; ix < 2; ++ix) {
+        const double column = double(e[ix]) + e[ix + 2];
+        s.p_lower[ix] = column > 0 ? float(e[ix] / column) : 0.5f;
+        // From the rounded probabilities, not from e: the density is the sampling's, and a
+        // quadrant whose probability rounded to 0 has density 0.
+        const double p_column = ix ? 1 - double(s.p_left) : double(s.p_left);
+        s.factor[ix] = float(4 * p_column * s.p_lower[ix]);
+        s.factor[ix + 2] = float(4 * p_column * (1 - double(s.p_lower[ix])));
+      }
+    }
+    s.children = next;
+    for (int q = 0; q < 4; ++q)
+      if (n.child[q]) {
+        s.children |= 1u << (28 + q);
+        order[next++] = n.child[q];
+      }
+  }
 }
 
-// Each level multiplies the density by 4 (a quadrant has a quarter of its parent's area) times
-// the quadrant's share of the parent's energy.
+// Each level multiplies the density by its quadrant's factor: 4 (a quadrant has a quarter of
+// its parent's area) times the quadrant's share of the parent's energy. The halvings of p are
+// exact in float (the quadrants' corners are dyadic).
 float DirectionalQuadtree::pdf_square(Vec2 p) const {
-  double x = p.x, y = p.y;
-  float pdf = 1;
+  if (sampling_.empty()) return 0;
+  float x = p.x, y = p.y, pdf = 1;
   uint32_t node = 0;
   for (;;) {
-    const int ix = x >= 0.5, iy = y >= 0.5, q = ix + 2 * iy;
-    pdf *= factor(node, q);
-    x = 2 * x - ix;
-    y = 2 * y - iy;
-    const uint32_t child = nodes_[node].child[q];
-    if (!child) return pdf;
-    node = child;
+    const SamplingNode& n = sampling_[node];
+    const int ix = x >= 0.5f, iy = y >= 0.5f, q = ix + 2 * iy;
+    pdf *= n.factor[q];
+    if (!n.inner(q)) return pdf;
+    x = 2 * x - float(ix);
+    y = 2 * y - float(iy);
+    node = n.child(q);
   }
 }
 
@@ -157,54 +186,46 @@ float DirectionalQuadtree::pdf(Vec3 w) const {
   return pdf_square(direction_to_square(w)) * kInv4Pi;
 }
 
-// Per level: the column (ix) with probability of its energy share, then the row (iy) within
-// the column; each rescales its coordinate of u to [0, 1), so the quadrant q is chosen with
-// probability e_q / total and u stays uniform for the next level.
+// Per level: the column (ix) with probability p_left, then the row (iy) within the column.
+// Instead of rescaling u at every level (two divisions), u stays where it is and each level
+// narrows the interval [lo, hi) of its coordinates that the chosen quadrant owns (the split at
+// lo + p (hi - lo)); u's place in the final interval is its place in the leaf. lo <= u < hi
+// holds throughout, so a column or row of probability 0 is never chosen (p = 1 is tested
+// explicitly: lo + (hi - lo) may round below hi).
 Vec2 DirectionalQuadtree::sample_square(Vec2 u, float* pdf) const {
-  double ux = u.x, uy = u.y;
+  const double ux = u.x, uy = u.y;
+  double x_lo = 0, x_hi = 1, y_lo = 0, y_hi = 1;
   double ox = 0, oy = 0, size = 1;
   float density = 1;  // as pdf_square() computes it
   uint32_t node = 0;
   for (;;) {
-    const std::array<float, 4>& e = nodes_[node].energy;
-    const double left = double(e[0]) + e[2], node_total = left + (double(e[1]) + e[3]);
-    const double p_left = left / node_total;
-    int ix;
-    if (ux < p_left) {
-      ix = 0;
-      ux /= p_left;
-    } else {
-      ix = 1;
-      ux = (ux - p_left) / (1 - p_left);
-    }
-    const double lower = e[ix], upper = e[ix + 2];  // promoted
-    const double p_lower = lower / (lower + upper);
-    int iy;
-    if (uy < p_lower) {
-      iy = 0;
-      uy /= p_lower;
-    } else {
-      iy = 1;
-      uy = (uy - p_lower) / (1 - p_lower);
-    }
-    ux = std::min(ux, 1.0);
-    uy = std::min(uy, 1.0);
+    const SamplingNode& n = sampling_[node];
+    const double x_split = x_lo + double(n.p_left) * (x_hi - x_lo);
+    const int ix = n.p_left < 1 && ux >= x_split;
+    (ix ? x_lo : x_hi) = x_split;
+    const float p_lower = n.p_lower[ix];
+    const double y_split = y_lo + double(p_lower) * (y_hi - y_lo);
+    const int iy = p_lower < 1 && uy >= y_split;
+    (iy ? y_lo : y_hi) = y_split;
+    const int q = ix + 2 * iy;
     size *= 0.5;
     ox += ix * size;
     oy += iy * size;
-    density *= factor(node, ix + 2 * iy);
-    const uint32_t child = nodes_[node].child[ix + 2 * iy];
-    if (!child) break;
-    node = child;
+    density *= n.factor[q];
+    if (!n.inner(q)) break;
+    node = n.child(q);
   }
   // The leaf's corners are dyadic (exact in float): keep the rounded point inside the leaf, so
   // that pdf_square() finds the leaf it was sampled from.
-  auto inside = [size](double origin, double t) {
-    const float lo = float(origin), hi = float(origin + size);
-    return std::clamp(float(origin + size * t), lo, std::nextafter(hi, lo));
+  auto inside = [size](double origin, double u, double lo, double hi) {
+    const double t = hi > lo ? (u - lo) / (hi - lo) : 0.5;
+    // The float below `last` (> 0): its bits minus one, as std::nextafter without the call.
+    const float first = float(origin),
+                below = std::bit_cast<float>(std::bit_cast<uint32_t>(float(origin + size)) - 1);
+    return std::clamp(float(origin + size * t), first, below);
   };
   if (pdf) *pdf = density;
-  return {inside(ox, ux), inside(oy, uy)};
+  return {inside(ox, ux, x_lo, x_hi), inside(oy, uy, y_lo, y_hi)};
 }
 
 DirectionalQuadtree DirectionalQuadtree::refined(double rho, int max_depth, size_t* node_budget,

@@ -8,6 +8,11 @@
 // is a leaf (child 0) or an inner node. A node stores the energy of each quadrant; recording adds
 // to leaf quadrants only and propagate() fills the inner sums, so splatting order does not
 // change the structure (and, splatted in a fixed order, not the sums either).
+//
+// Sampling and densities read a second, compact layout that propagate() builds (SamplingNode:
+// 32 bytes per node holding what a descent needs, nodes breadth first with the children of a
+// node side by side): a descent is one load per level where the learning layout took two
+// (energies and factors) and four divisions.
 #pragma once
 
 #include <array>
@@ -49,17 +54,17 @@ class DirectionalQuadtree {
   // (reflected back into the square in u, wrapped in v). Its expectation over u in [0, 1)^2 is
   // record_filtered(); it costs two descents instead of a walk over every overlapped quadrant.
   void record_jittered(Vec2 p, double value, Vec2 u);
-  // Recomputes inner nodes' energies from the leaves (bottom up), and each node's density
-  // factors (4 e_q / total per quadrant), which pdf_square() and sample_square() multiply along
-  // the descent instead of dividing at every level (record() after it leaves them stale until
-  // the next propagate(); a sampling distribution is no longer recorded into).
+  // Recomputes inner nodes' energies from the leaves (bottom up) and builds the sampling layout
+  // from them (record() after it leaves that stale until the next propagate(); a sampling
+  // distribution is no longer recorded into).
   void propagate();
 
-  // Density on the unit square at p; 0 everywhere if total() == 0. Solid angle: pdf / (4 pi).
+  // Density on the unit square at p, of the distribution of the last propagate(); 0 everywhere
+  // if total() == 0 or before any propagate(). Solid angle: pdf / (4 pi).
   float pdf_square(Vec2 p) const;
   float pdf(Vec3 w) const;
   // Hierarchical sample warping (Müller et al. 2017, sec. 3.3 and its appendix): u picks a
-  // quadrant per level and is rescaled; requires total() > 0. With pdf, also the density on
+  // quadrant per level; requires total() > 0 and propagate(). With pdf, also the density on
   // the square of the leaf it lands in: bit for bit what pdf_square() returns there.
   Vec2 sample_square(Vec2 u, float* pdf = nullptr) const;
   Vec3 sample(Vec2 u) const { return square_to_direction(sample_square(u)); }
@@ -75,15 +80,39 @@ class DirectionalQuadtree {
 
   size_t node_count() const { return nodes_.size(); }
   size_t bytes() const {
-    return nodes_.capacity() * sizeof(Node) + factors_.capacity() * sizeof(factors_[0]);
+    return nodes_.capacity() * sizeof(Node) + sampling_.capacity() * sizeof(SamplingNode);
   }
   void shrink_to_fit() {
     nodes_.shrink_to_fit();
-    factors_.shrink_to_fit();
+    sampling_.shrink_to_fit();
   }
   int depth() const;
-  // Per node, sampled or recorded: the node and its density factors.
-  static constexpr size_t kNodeBytes = sizeof(Node) + sizeof(std::array<float, 4>);
+
+  // A node of the sampling layout. Sampling picks the column ix = 0 with probability p_left =
+  // (e_0 + e_2) / (sum of e) and then, in column ix, the row iy = 0 with probability
+  // p_lower[ix] = e_ix / (e_ix + e_ix+2) (both rounded to float); quadrant q multiplies the
+  // density by factor[q] = 4 P(q) (a quarter of the parent's area; P(q) = e_q / sum but for the
+  // rounding, and 0 where the node has no energy).
+  struct SamplingNode {
+    static constexpr uint32_t kIndexMask = (1u << 28) - 1;
+    float p_left = 0.5f;
+    std::array<float, 2> p_lower{0.5f, 0.5f};
+    // Bits 0-27: the index of the first child; bit 28 + q: quadrant q is an inner node. The
+    // children of the inner quadrants follow one another in quadrant order.
+    uint32_t children = 0;
+    std::array<float, 4> factor{};
+    bool inner(int q) const { return (children >> (28 + q)) & 1; }
+    // The first child plus the inner quadrants before q: the popcount of a 3-bit mask m, read
+    // from the 2-bit fields of 0xE994 (0, 1, 1, 2, 1, 2, 2, 3; a baseline x86-64 build has no
+    // popcount instruction, and std::popcount becomes a library call).
+    uint32_t child(int q) const {
+      const uint32_t before = (children >> 28) & ((1u << q) - 1);
+      return (children & kIndexMask) + ((0xE994u >> (2 * before)) & 3);
+    }
+  };
+  static_assert(sizeof(SamplingNode) == 32);
+  // Per node, sampled or recorded: the node and its sampling layout.
+  static constexpr size_t kNodeBytes = sizeof(Node) + sizeof(SamplingNode);
 
  private:
   // Adds density * (overlap area) of the box [x0, x1) x [y0, y1) to the leaf quadrants under
@@ -93,19 +122,8 @@ class DirectionalQuadtree {
   // Side of the leaf quadrant holding p.
   double leaf_size(Vec2 p) const;
 
-  // Quadrant q of node n multiplies the density by factor(n, q) = 4 e_q / (sum of e) (0 where
-  // the node has no energy): from
-  // factors_ when propagate() filled it, else computed (the same float expression either way,
-  // so that sample_square() and pdf_square() agree bit for bit).
-  float factor(uint32_t node, int q) const {
-    if (factors_.size() == nodes_.size()) return factors_[node][q];
-    const std::array<float, 4>& e = nodes_[node].energy;
-    const float total = (e[0] + e[1]) + (e[2] + e[3]);
-    return total > 0 ? 4 * e[q] / total : 0.f;  // no energy below: density 0
-  }
-
-  std::vector<Node> nodes_;  // nodes_[0] is the root; children come after their parents
-  std::vector<std::array<float, 4>> factors_;
+  std::vector<Node> nodes_;             // nodes_[0] is the root; children come after their parents
+  std::vector<SamplingNode> sampling_;  // from propagate(): sampling_[0] is the root
 };
 
 }  // namespace caustica

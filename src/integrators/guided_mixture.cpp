@@ -40,7 +40,17 @@ std::optional<MixtureSample> sample_mixture(const Bsdf& bsdf, Vec3 wo, const Mix
       s.weight = walk * (s.pdfs.bsdf / s.pdf);
       return s;
     }
-    s.pdfs = m.evaluate(bsdf, wo, s.wi);
+    // The BSDF's own sample carries f and its density (the BSDF tests check that they are
+    // f() and pdf()): only the guide's density is evaluated.
+    s.pdfs.square = direction_to_square(s.wi);
+    s.pdfs.bsdf = bs->pdf;
+    s.pdfs.guide = m.guide->pdf_square(s.pdfs.square) * kInv4Pi;
+    s.pdf = m.pdf(s.pdfs);
+    if (!(s.pdf > 0)) return std::nullopt;
+    const Rgb f_cos = bs->f * bsdf.abs_cos(s.wi);
+    s.weight = f_cos / s.pdf;
+    s.bsdf_weight = f_cos / bs->pdf;
+    return s;
   }
   s.pdf = m.pdf(s.pdfs);
   if (!(s.pdf > 0)) return std::nullopt;

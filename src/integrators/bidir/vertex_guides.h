@@ -132,7 +132,16 @@ inline std::optional<GuidedSample> sample_guided(const Bsdf& bsdf, const VertexG
       s.weight = walk * (s.bsdf_pdf / s.pdf);
       return s;
     }
+    // f and the BSDF's density come with its sample (the BSDF tests check that they are f()
+    // and pdf()): only the guide's density is evaluated.
     s.guide_pdf = g.guide_pdf(mode, wo, s.wi);
+    s.bsdf_pdf = bs->pdf;
+    s.pdf = a * bs->pdf + (1 - a) * s.guide_pdf;
+    const Rgb f_cos = bs->f * bsdf.abs_cos(s.wi);
+    if (!(s.pdf > 0) || f_cos.is_black()) return std::nullopt;
+    s.weight = f_cos / s.pdf;
+    s.bsdf_weight = f_cos / bs->pdf;
+    return s;
   } else {
     // The sampled point's leaf density is the guide's density of the direction (as guided-pt:
     // the round trip through direction_to_square() agrees but within rounding at leaf borders),

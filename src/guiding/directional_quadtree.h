@@ -11,8 +11,8 @@
 //
 // Sampling and densities read a second, compact layout that propagate() builds (SamplingNode:
 // 32 bytes per node holding what a descent needs, nodes breadth first with the children of a
-// node side by side): a descent is one load per level where the learning layout took two
-// (energies and factors) and four divisions.
+// node side by side): a descent is one load per level and no division (from the energies it
+// would take a division per coordinate and level, and the children's indices would scatter).
 #pragma once
 
 #include <array>

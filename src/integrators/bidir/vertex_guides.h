@@ -111,6 +111,13 @@ inline std::optional<GuidedSample> sample_guided(const Bsdf& bsdf, const VertexG
   const DirectionalQuadtree& guide = *g.guide(mode, wo);
   const float a = g.bsdf_fraction(mode, wo);
   GuidedSample s;
+  // The weights from f |cos| at s.wi, once s.pdf (> 0) and s.bsdf_pdf are set.
+  auto weigh = [&s](Rgb f_cos) -> std::optional<GuidedSample> {
+    if (f_cos.is_black()) return std::nullopt;
+    s.weight = f_cos / s.pdf;
+    s.bsdf_weight = s.bsdf_pdf > 0 ? f_cos / s.bsdf_pdf : Rgb(0.f);
+    return s;
+  };
   if (u_technique < a) {
     const auto bs = bsdf.sample(wo, uc, u, mode);
     if (!bs) return std::nullopt;
@@ -136,29 +143,20 @@ inline std::optional<GuidedSample> sample_guided(const Bsdf& bsdf, const VertexG
     // and pdf()): only the guide's density is evaluated.
     s.guide_pdf = g.guide_pdf(mode, wo, s.wi);
     s.bsdf_pdf = bs->pdf;
-    s.pdf = a * bs->pdf + (1 - a) * s.guide_pdf;
-    const Rgb f_cos = bs->f * bsdf.abs_cos(s.wi);
-    if (!(s.pdf > 0) || f_cos.is_black()) return std::nullopt;
-    s.weight = f_cos / s.pdf;
-    s.bsdf_weight = f_cos / bs->pdf;
-    return s;
-  } else {
-    // The sampled point's leaf density is the guide's density of the direction (as guided-pt:
-    // the round trip through direction_to_square() agrees but within rounding at leaf borders),
-    // without a second descent.
-    float density;
-    s.wi = square_to_direction(guide.sample_square(u, &density));
-    s.guide_pdf = density * kInv4Pi;
+    s.pdf = a * s.bsdf_pdf + (1 - a) * s.guide_pdf;
+    if (!(s.pdf > 0)) return std::nullopt;
+    return weigh(bs->f * bsdf.abs_cos(s.wi));
   }
-  const float bsdf_pdf = bsdf.pdf(wo, s.wi, mode);
-  s.bsdf_pdf = bsdf_pdf;
-  s.pdf = a * bsdf_pdf + (1 - a) * s.guide_pdf;
+  // The sampled point's leaf density is the guide's density of the direction (as guided-pt: the
+  // round trip through direction_to_square() agrees but within rounding at leaf borders),
+  // without a second descent.
+  float density;
+  s.wi = square_to_direction(guide.sample_square(u, &density));
+  s.guide_pdf = density * kInv4Pi;
+  s.bsdf_pdf = bsdf.pdf(wo, s.wi, mode);
+  s.pdf = a * s.bsdf_pdf + (1 - a) * s.guide_pdf;
   if (!(s.pdf > 0)) return std::nullopt;
-  const Rgb f_cos = bsdf.f(wo, s.wi, mode) * bsdf.abs_cos(s.wi);
-  if (f_cos.is_black()) return std::nullopt;
-  s.weight = f_cos / s.pdf;
-  s.bsdf_weight = bsdf_pdf > 0 ? f_cos / bsdf_pdf : Rgb(0.f);
-  return s;
+  return weigh(bsdf.f(wo, s.wi, mode) * bsdf.abs_cos(s.wi));
 }
 
 }  // namespace caustica::bidir

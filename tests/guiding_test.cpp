@@ -442,6 +442,45 @@ TEST(Guiding, SplatReadsRunsInOrderWhereverTheyAreStored) {
 // The learned selection probability moves toward the technique whose density matches the
 // product f |cos| L_i: toward the BSDF when the product follows it, toward the guide when the
 // product follows the guide (samples drawn from the current mixture, as the integrator does).
+// Next event estimation's learned probability (GuidingSettings::nee_floor): a leaf that took
+// kNeeEvidence light samples and saw no light drops to the floor, the children of a split
+// inherit it, a leaf with fewer samples keeps what it had and one that saw light goes back to 1.
+TEST(Guiding, NextEventProbabilityDropsWhereNoLightIsSeen) {
+  GuidingSettings settings;
+  settings.spatial_threshold = 10;
+  GuidingField field(Bounds3{{0, 0, 0}, {1, 1, 1}}, settings);
+  ASSERT_EQ(field.leaf_count(), 1u);
+  EXPECT_EQ(field.guide(0).nee_probability, 1.f);
+  field.add_nee_counts({GuidingField::kNeeEvidence, 0});
+  field.add_vertex_counts({100});  // the leaf splits at the end of the pass
+  field.end_pass(0);
+  ASSERT_GT(field.leaf_count(), 1u);
+  EXPECT_EQ(field.reduced_nee_leaves(), field.leaf_count());
+  for (uint32_t l = 0; l < field.leaf_count(); ++l)
+    EXPECT_EQ(field.guide(l).nee_probability, settings.nee_floor) << l;
+  const uint32_t a = field.leaf_at(Vec3(0.1f, 0.1f, 0.1f)),
+                 b = field.leaf_at(Vec3(0.9f, 0.9f, 0.9f));
+  const uint32_t c = field.leaf_at(Vec3(0.1f, 0.9f, 0.9f));
+  ASSERT_TRUE(a != b && b != c && a != c);
+  std::vector<uint32_t> counts(2 * field.leaf_count(), 0);
+  counts[2 * a] = GuidingField::kNeeEvidence - 1;  // too few to tell: stays at the floor
+  counts[2 * b] = 3;                               // saw light once: back to 1
+  counts[2 * b + 1] = 1;
+  field.add_nee_counts(counts);
+  field.end_pass(1);
+  EXPECT_EQ(field.guide(a).nee_probability, settings.nee_floor);
+  EXPECT_EQ(field.guide(b).nee_probability, 1.f);
+  EXPECT_EQ(field.guide(c).nee_probability, settings.nee_floor);
+  // Seeing light in a few of many samples counts as light unless nee_visible_share allows it.
+  for (const float share : {0.f, 0.1f}) {
+    settings.nee_visible_share = share;
+    GuidingField f(Bounds3{{0, 0, 0}, {1, 1, 1}}, settings);
+    f.add_nee_counts({1000, 50});
+    f.end_pass(0);
+    EXPECT_EQ(f.guide(0).nee_probability, share > 0 ? settings.nee_floor : 1.f) << share;
+  }
+}
+
 TEST(Guiding, SelectionProbabilityFollowsTheBetterTechnique) {
   // Densities on [0, 1]: the BSDF is uniform, the guide is 1.9 on [0, 1/2) and 0.1 elsewhere.
   auto guide_pdf = [](float x) { return x < 0.5f ? 1.9f : 0.1f; };
@@ -865,6 +904,35 @@ TEST(GuidedPathTracer, TrainedFieldBitIdenticalForOneAndTwoThreads) {
   for (size_t i = 0; i < a.image.pixel_count(); ++i)
     if (!(a.image[i] == b.image[i])) ++differing;
   EXPECT_EQ(differing, 0u);
+}
+
+// Next event estimation at a learned probability q stays unbiased: the light sample's density
+// is q p_light in its own weight and in the emitter hits' weights (the MIS weights still sum to
+// one). In the furnace (a closed emitting sphere of albedo 1/2: radiance Le / (1 - a)
+// everywhere) every light sample sees light, so the floor is forced onto every leaf
+// (nee_visible_share 1), and the light and BSDF densities are alike, so the weights matter.
+TEST(GuidedPathTracer, NextEventProbabilityKeepsTheEstimateUnbiased) {
+  FurnaceParams p;
+  p.albedo = 0.5f;
+  p.emission = 1.5f;
+  auto scene = make_furnace_scene(p, 24, 24);
+  IntegratorSettings s;
+  s.max_depth = 200;
+  s.guiding.nee_floor = 0.25f;
+  s.guiding.nee_visible_share = 1;
+  GuidedPathTracer integrator(s);
+  const nlohmann::json stats = render_and_report(*scene, integrator, 16);
+  EXPECT_EQ(stats["guiding"]["nee_reduced_leaves"].get<size_t>(), 6u);  // the six side classes
+  const auto st = test::over_seeds(6, [&](uint64_t seed) {
+    s.seed = seed;
+    const auto r = test::render_with(*scene, "guided-pt", 16, s);
+    EXPECT_EQ(r.nonfinite, 0u);
+    return test::pixel_stats(r.image).mean;
+  });
+  std::printf("[ nee floor ] guided-pt mean %.5f se %.5f (expected %.5f)\n", st.mean,
+              st.standard_error, p.expected_radiance());
+  EXPECT_NEAR(st.mean, p.expected_radiance(), 3 * st.standard_error + 1e-5);
+  EXPECT_LT(st.standard_error, 0.01 * p.expected_radiance()) << "the test has power";
 }
 
 // The record buffers do not grow with the resolution: beyond kMaxRecords records per iteration,

@@ -24,7 +24,8 @@ struct SceneSetup {
   // ignore it).
   BidirSettings bidir;  // --light-paths, --radius, --radius-alpha, --techniques, --connections
   std::string adaptive_costs;  // --adaptive-costs: "", "model" or "measured"
-  // --guiding-spatial-threshold, --guiding-rho, --guiding-bsdf-fraction; the others below.
+  // --guiding-spatial-threshold, --guiding-rho, --guiding-bsdf-fraction, --guiding-nee-floor;
+  // the others below.
   GuidingSettings guiding;
   int guiding_max_mb = 32;                           // --guiding-max-mb
   std::string guiding_filter = "on";                 // --guiding-filter

@@ -134,6 +134,17 @@ void GuidingField::add_vertex_counts(const std::vector<uint32_t>& counts) {
   for (size_t i = 0; i < counts.size() && i < counts_.size(); ++i) counts_[i] += counts[i];
 }
 
+void GuidingField::add_nee_counts(const std::vector<uint32_t>& counts) {
+  if (nee_counts_.size() != 2 * leaves_.size()) nee_counts_.assign(2 * leaves_.size(), 0);
+  for (size_t i = 0; i < counts.size() && i < nee_counts_.size(); ++i) nee_counts_[i] += counts[i];
+}
+
+size_t GuidingField::reduced_nee_leaves() const {
+  size_t n = 0;
+  for (const Leaf& l : leaves_) n += l.nee_probability < 1;
+  return n;
+}
+
 uint32_t GuidingField::leaf_at(Vec3 p, int side) const {
   const Vec3 q = class_point(p, side);
   return leaf_of_point(q, start_node(q));
@@ -171,7 +182,8 @@ void GuidingField::refresh_guides() {
   }
   for (uint32_t i = 0; i < leaves_.size(); ++i) {
     const Leaf& l = leaves_[i];
-    guides_[i] = {l.sampling.total() > 0 ? &l.sampling : nullptr, bsdf_fraction(i)};
+    guides_[i] = {l.sampling.total() > 0 ? &l.sampling : nullptr, bsdf_fraction(i),
+                  l.nee_probability};
   }
 }
 
@@ -320,6 +332,19 @@ void GuidingField::split_leaves(int k) {
 }
 
 void GuidingField::end_pass(int k) {
+  if (nee_counts_.size() == 2 * leaves_.size()) {
+    const float floor = std::clamp(settings_.nee_floor, 0.f, 1.f);
+    for (size_t i = 0; i < leaves_.size(); ++i) {
+      const uint64_t taken = nee_counts_[2 * i], visible = nee_counts_[2 * i + 1];
+      const bool dark = double(visible) <= double(settings_.nee_visible_share) * double(taken);
+      if (!dark) {
+        leaves_[i].nee_probability = 1;
+      } else if (taken >= kNeeEvidence && floor > 0) {
+        leaves_[i].nee_probability = floor;
+      }
+    }
+  }
+  nee_counts_.clear();
   for (Leaf& l : leaves_) {
     l.recording.propagate();
     l.sampling = std::move(l.recording);
@@ -351,8 +376,8 @@ size_t GuidingField::quadtree_node_count() const {
 
 size_t GuidingField::memory_bytes() const {
   size_t bytes = nodes_.capacity() * sizeof(SpatialNode) + leaves_.capacity() * sizeof(Leaf) +
-                 counts_.capacity() * sizeof(uint64_t) + guides_.capacity() * sizeof(Guide) +
-                 start_.capacity() * sizeof(uint32_t);
+                 (counts_.capacity() + nee_counts_.capacity()) * sizeof(uint64_t) +
+                 guides_.capacity() * sizeof(Guide) + start_.capacity() * sizeof(uint32_t);
   for (const Leaf& l : leaves_) bytes += l.sampling.bytes() + l.recording.bytes();
   return bytes;
 }

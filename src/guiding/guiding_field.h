@@ -91,6 +91,7 @@ class GuidingField {
   struct Guide {
     const DirectionalQuadtree* distribution = nullptr;
     float bsdf_fraction = 1;
+    float nee_probability = 1;  // see add_nee_counts()
   };
   const Guide& guide(uint32_t leaf) const { return guides_[leaf]; }
 
@@ -98,6 +99,17 @@ class GuidingField {
   // rule. Every guided vertex counts, whether or not it found radiance (Müller et al. 2017:
   // "path vertices"). Callers count per thread and add the integers in any order.
   void add_vertex_counts(const std::vector<uint32_t>& counts);
+  // Adds next event samples per leaf: counts[2 leaf] light samples taken at the leaf's
+  // vertices, counts[2 leaf + 1] of them unoccluded with a non-zero contribution (callers count
+  // per thread, as above). end_pass() sets the probability of next event estimation of a leaf
+  // that saw light to 1 and of one that took at least kNeeEvidence samples and saw none (at most
+  // GuidingSettings::nee_visible_share of them) to GuidingSettings::nee_floor; a leaf with fewer
+  // samples keeps its probability (children inherit their parent's). A leaf at the floor still
+  // takes light samples: a later pass that sees light there sets it back to 1.
+  static constexpr uint32_t kNeeEvidence = 64;
+  void add_nee_counts(const std::vector<uint32_t>& counts);
+  // The leaves whose next event probability is below 1 (a statistic).
+  size_t reduced_nee_leaves() const;
   // Records one sample directly (sequential; tests), counting it as a vertex when its
   // statistical weight is positive.
   void record(const GuidingRecord& r);
@@ -133,6 +145,7 @@ class GuidingField {
     DirectionalQuadtree sampling, recording;
     SelectionOptimizer selection;
     double carry_share = 1;  // of its distribution's energy, halved at each split (carry)
+    float nee_probability = 1;
   };
   void record_into(Leaf& leaf, const GuidingRecord& r);
   // Splits a leaf node in two at the middle of `axis` (-1: its box's longest axis).
@@ -163,8 +176,9 @@ class GuidingField {
   std::array<int, 3> start_dims_{1, 1, 1};
   Vec3 start_origin_, start_scale_;  // cell coordinates of p: (p - origin) * scale
   std::vector<Leaf> leaves_;
-  std::vector<uint64_t> counts_;  // path vertices per leaf in the current pass
-  std::vector<Guide> guides_;     // per leaf
+  std::vector<uint64_t> counts_;      // path vertices per leaf in the current pass
+  std::vector<uint64_t> nee_counts_;  // per leaf: light samples taken, of them seeing light
+  std::vector<Guide> guides_;         // per leaf
   // Uninitialised storage for splat()'s records grouped by leaf, grown and kept, so that the
   // parallel scatter, not a serial constructor, first touches its pages. A copy starts empty.
   class RecordScratch {

@@ -76,6 +76,16 @@ struct GuidingSettings {
   // Rendering passes enter the image weighted by their inverse variance (Müller 2019); false:
   // every iteration with equal weight.
   bool inverse_variance = true;
+  // guided-pt: the probability of next event estimation at a vertex whose spatial leaf saw no
+  // light in the last training pass that tested it (at least GuidingField::kNeeEvidence light
+  // samples, none unoccluded with f > 0); everywhere else, and until then, 1. The light
+  // sample's density is scaled by the probability in every weight, so the estimate stays
+  // unbiased (guided_path_tracer.cpp). 1: next event estimation everywhere, as Müller et al.
+  float nee_floor = 0.25f;
+  // The share of a leaf's light samples that may see light for it still to count as seeing
+  // none (0: not one). Above 0 the floor also reaches leaves where light arrives; the tests use
+  // 1 (every leaf with enough samples) to check that the weights stay a partition of unity.
+  float nee_visible_share = 0;
 };
 
 }  // namespace caustica

@@ -35,8 +35,10 @@ struct DirectionPdfs {
 struct Mixture {
   const DirectionalQuadtree* guide = nullptr;
   float bsdf_fraction = 1;
-  uint32_t record_leaf = 0;  // where this vertex's records go (the spatial filter's jitter)
-  bool guidable = false;     // records are learned here
+  uint32_t leaf = 0;          // the vertex's spatial leaf
+  uint32_t record_leaf = 0;   // where this vertex's records go (the spatial filter's jitter)
+  bool guidable = false;      // records are learned here
+  float nee_probability = 1;  // of next event estimation here (GuidingSettings::nee_floor)
   // The records' weight along wi: |cos| to the shading normal where the guides learn the
   // product with the cosine (GuidingSettings::cosine_product), else 1.
   Vec3 cosine_normal;

@@ -41,7 +41,8 @@ Mixture mixture_at(const GuidingField& field, const GuidingSettings& settings, b
     mix.guide = guide.distribution;
     mix.bsdf_fraction = guide.bsdf_fraction;
   }
-  mix.record_leaf = leaf;
+  mix.nee_probability = guide.nee_probability;
+  mix.leaf = mix.record_leaf = leaf;
   if (!learn) return mix;
   if (settings.cosine_product) mix.cosine_normal = si.shading.n;
   if (settings.filter) {
@@ -168,6 +169,10 @@ void GuidedPathTracer::render_iteration(const Scene& scene, uint32_t iteration, 
     field_.add_vertex_counts(counts);
     std::fill(counts.begin(), counts.end(), 0);
   }
+  for (std::vector<uint32_t>& counts : nee_counts_) {
+    field_.add_nee_counts(counts);
+    std::fill(counts.begin(), counts.end(), 0);
+  }
   field_.splat(records_.runs());
   recorded_ += recorded;
   peak_record_bytes_ =
@@ -231,11 +236,15 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
   // Rendering passes and unrecorded pixels learn nothing: no per-thread buffers are looked up.
   std::optional<PathLearning> learning;
   std::vector<uint32_t>* vertex_counts = nullptr;
+  std::vector<uint32_t>* nee_counts = nullptr;
   if (learn) {
     learning.emplace(arena, settings_.max_depth, sample.pixel,
                      records_.writer(sample.pixel / record_stride_), float(record_stride_));
     vertex_counts = &vertex_counts_.local();
     if (vertex_counts->size() != field_.leaf_count()) vertex_counts->assign(field_.leaf_count(), 0);
+    nee_counts = &nee_counts_.local();
+    if (nee_counts->size() != 2 * field_.leaf_count())
+      nee_counts->assign(2 * field_.leaf_count(), 0);
   }
   Rgb L(0.f), beta(1.f);
   Rgb rr_beta(1.f);  // the throughput of BSDF sampling, for Russian roulette
@@ -245,14 +254,16 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
   float eta_scale = 1;  // refractions sampled by the BSDF, undone for Russian roulette
   float prev_pdf = 0;   // density of the direction that produced `ray` (mixture where guided)
   Vec3 prev_p;
+  float prev_nee = 1;  // the probability of next event estimation at prev_p
 
   auto add = [&](Rgb c) {
     L += c;
     if (learn) learning->contribute(c);
   };
   auto add_emission = [&](const SurfaceInteraction* hit) {
-    add_emission_seen(scene, ray, hit, depth == 0 || specular_bounce, prev_pdf, prev_p, heuristic,
-                      [&](Rgb Le, float w) { add(beta * Le * w); });
+    add_emission_seen(
+        scene, ray, hit, depth == 0 || specular_bounce, prev_pdf, prev_p, heuristic,
+        [&](Rgb Le, float w) { add(beta * Le * w); }, prev_nee);
   };
 
   for (;;) {
@@ -273,12 +284,22 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
       return mix.pdf(nee_pdfs);
     };
 
-    const float u_light = rng.next_float();
+    // With the leaf's probability q (1 unless it saw no light: GuidingSettings::nee_floor), u_light
+    // below q runs it, rescaled to pick the light (q = 1: always, with the same numbers).
+    float u_light = rng.next_float();
     const Vec2 u = rng.next_2d();
+    const float q = mix.nee_probability;
     NextEventSeen seen;
-    add(direct_light_mis(
-        scene, si, bsdf, beta, u_light, u, mixture_pdf,
-        [&](float a, float b) { return mis_weight(heuristic, a, b); }, &seen));
+    if (u_light < q) {
+      if (q < 1) u_light = std::min(u_light / q, kOneMinusEpsilon);
+      add(direct_light_mis(
+          scene, si, bsdf, beta, u_light, u, mixture_pdf,
+          [&](float a, float b) { return mis_weight(heuristic, a, b); }, &seen, q));
+      if (learn && mix.guidable && !bsdf.is_delta() && !scene.light_sampler().empty()) {
+        ++(*nee_counts)[2 * mix.leaf];
+        (*nee_counts)[2 * mix.leaf + 1] += !seen.Li.is_black();
+      }
+    }
     if (learn && mix.guidable && !seen.Li.is_black())
       learning->add_next_event(mix, seen,
                                nee_evaluated ? nee_pdfs : mix.evaluate(bsdf, wo, seen.wi));
@@ -296,6 +317,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
       if (!s->specular) learning->add_vertex(mix, *s, beta);
     }
     prev_pdf = s->pdf;
+    prev_nee = q;
     specular_bounce = s->specular;
     prev_p = si.p;
     ray = si.spawn_ray(s->wi);
@@ -320,6 +342,8 @@ void GuidedPathTracer::report(nlohmann::json& stats) const {
   g["record_pixel_stride_last"] = record_stride_;
   g["radiance_samples_recorded"] = recorded_;
   g["mean_bsdf_fraction"] = field_.mean_bsdf_fraction();
+  g["nee_floor"] = settings_.guiding.nee_floor;
+  g["nee_reduced_leaves"] = field_.reduced_nee_leaves();
   report_passes(passes_, !film_is_the_image(), pass_end_seconds_, seconds_since_start(), g);
   if (settings_.guiding.inverse_variance && film_is_the_image() &&
       schedule_.rendering_from() >= 0) {

@@ -123,6 +123,8 @@ class GuidedPathTracer final : public CameraPathIntegrator {
   PixelRecords records_;
   // Path vertices per spatial leaf, per thread (added to the field after each iteration).
   mutable tbb::enumerable_thread_specific<std::vector<uint32_t>> vertex_counts_;
+  // Per thread and leaf: next event samples taken and of them seeing light (learning pixels).
+  mutable tbb::enumerable_thread_specific<std::vector<uint32_t>> nee_counts_;
   nlohmann::json views_;  // what was learned at a few pixels (guide_views.h), by finish()
   // Written by estimate(): one writer per pixel at a time.
   mutable InverseVarianceCombiner passes_;

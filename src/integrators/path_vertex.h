@@ -54,17 +54,19 @@ inline float mis_weight(MisHeuristic heuristic, float pdf_a, float pdf_b) {
 // Emission seen along a sampled ray (at `hit`, or the infinite lights with hit == nullptr),
 // handed to add(Rgb Le, float weight): weight 1 for the camera ray and after a delta bounce (no
 // light sample could have found it), else the MIS weight against next event estimation from
-// prev_p, the ray having been sampled with density prev_pdf.
+// prev_p, the ray having been sampled with density prev_pdf. nee_probability: the probability
+// with which prev_p ran next event estimation at all (direct_light_mis's `probability`).
 template <typename Add>
 void add_emission_seen(const Scene& scene, const Ray& ray, const SurfaceInteraction* hit,
                        bool full_weight, float prev_pdf, Vec3 prev_p, MisHeuristic heuristic,
-                       Add&& add) {
+                       Add&& add, float nee_probability = 1) {
   for_each_emitter_seen(scene.infinite_lights(), ray, hit, [&](const Light& light, Rgb Le) {
     if (full_weight) {
       add(Le, 1.f);
       return;
     }
-    const float light_pdf = next_event_pdf(scene.light_sampler(), light, prev_p, ray.d, hit);
+    const float light_pdf =
+        nee_probability * next_event_pdf(scene.light_sampler(), light, prev_p, ray.d, hit);
     add(Le, mis_weight(heuristic, prev_pdf, light_pdf));
   });
 }
@@ -120,16 +122,19 @@ struct NextEventSeen {
 // BSDFs and light-less scenes). sampling_pdf(wi) is the solid-angle density with which the
 // path's own direction sampling would pick wi; mis(p_light, p_sampling) the heuristic; delta
 // lights get weight 1. With `seen`, an unoccluded sample is also described there (else
-// seen->Li is black).
+// seen->Li is black). probability: the probability with which the caller runs next event
+// estimation at this vertex (guided-pt's learned one, guided_path_tracer.cpp); it scales the
+// light sample's density, so the estimate stays unbiased and, with add_emission_seen's
+// nee_probability, the MIS weights still sum to one.
 template <typename SamplingPdf, typename Mis>
 Rgb direct_light_mis(const Scene& scene, const SurfaceInteraction& si, const Bsdf& bsdf, Rgb beta,
                      float u_light, Vec2 u, SamplingPdf&& sampling_pdf, Mis&& mis,
-                     NextEventSeen* seen = nullptr) {
+                     NextEventSeen* seen = nullptr, float probability = 1) {
   if (seen) seen->Li = Rgb(0.f);
   if (bsdf.is_delta() || scene.light_sampler().empty()) return Rgb(0.f);
   const auto d = sample_direct_light(scene, si, bsdf, u_light, u);
   if (!d || scene.occluded(d->shadow)) return Rgb(0.f);
-  const float light_pdf = d->pmf * d->ls.pdf_w;
+  const float light_pdf = probability * (d->pmf * d->ls.pdf_w);
   const float w = d->light->is_delta() ? 1.f : mis(light_pdf, sampling_pdf(d->ls.wi));
   if (seen) *seen = {d->ls.wi, d->ls.radiance, d->f, light_pdf, w, d->light->is_delta()};
   return beta * d->f * d->ls.radiance * (w / light_pdf);

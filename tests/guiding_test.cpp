@@ -912,9 +912,7 @@ TEST(GuidedPathTracer, TrainedFieldBitIdenticalForOneAndTwoThreads) {
 // everywhere) every light sample sees light, so the floor is forced onto every leaf
 // (nee_visible_share 1), and the light and BSDF densities are alike, so the weights matter.
 TEST(GuidedPathTracer, NextEventProbabilityKeepsTheEstimateUnbiased) {
-  FurnaceParams p;
-  p.albedo = 0.5f;
-  p.emission = 1.5f;
+  const FurnaceParams p{0.5f, 1.5f};  // radiance 3
   auto scene = make_furnace_scene(p, 24, 24);
   IntegratorSettings s;
   s.max_depth = 200;

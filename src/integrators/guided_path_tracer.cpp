@@ -295,7 +295,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
       add(direct_light_mis(
           scene, si, bsdf, beta, u_light, u, mixture_pdf,
           [&](float a, float b) { return mis_weight(heuristic, a, b); }, &seen, q));
-      if (learn && mix.guidable && !bsdf.is_delta() && !scene.light_sampler().empty()) {
+      if (learn && mix.guidable && !scene.light_sampler().empty()) {  // guidable: not delta
         ++(*nee_counts)[2 * mix.leaf];
         (*nee_counts)[2 * mix.leaf + 1] += !seen.Li.is_black();
       }

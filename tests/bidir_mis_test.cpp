@@ -245,16 +245,26 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
     for (int i = lo; i <= hi; ++i) p *= v[i];
     return p;
   };
+  // The learned probability with which the vertex x_i takes technique t toward x_j (guided:
+  // next event estimation, lens connections and connections; technique_probabilities.h):
+  // it multiplies that technique's count.
+  auto q = [&](GuidingField::Technique t, int i, Vec3 toward) {
+    if (!guiding) return 1.0;
+    return double(guiding->probabilities_at(x[i], path.surfaces[i - 1].ng).of(t, toward));
+  };
   std::map<Key, double> p;
   if (connect && !light.is_delta()) p[{false, 0, k + 1}] = prod(camera_pdf, 0, k - 1);
-  if (connect && k >= 2 && !delta(1)) p[{false, 1, k}] = nee_pdf * prod(camera_pdf, 1, k - 1);
+  if (connect && k >= 2 && !delta(1))
+    p[{false, 1, k}] = q(GuidingField::kNextEvent, 1, finite ? dir(1, 0) : -emit) * nee_pdf *
+                       prod(camera_pdf, 1, k - 1);
   for (int s = 2; connect && s <= k - 1; ++s)
     if (!delta(s - 1) && !delta(s))
-      p[{false, s, k + 1 - s}] =
-          connections * prod(light_pdf, 0, s - 1) * prod(camera_pdf, s, k - 1);
+      p[{false, s, k + 1 - s}] = q(GuidingField::kConnection, s - 1, dir(s - 1, s)) * connections *
+                                 prod(light_pdf, 0, s - 1) * prod(camera_pdf, s, k - 1);
   // t = 1; for k = 1 the emission point of an area light itself (s = 1, t = 1).
   if (connect && (k == 1 ? light.type() == LightType::Area : !delta(k - 1)))
-    p[{false, k, 1}] = light_paths * prod(light_pdf, 0, k - 1);
+    p[{false, k, 1}] = (k == 1 ? 1.0 : q(GuidingField::kLensConnection, k - 1, dir(k - 1, k))) *
+                       light_paths * prod(light_pdf, 0, k - 1);
   for (int j = 1; merge && j <= k - 1; ++j)
     if (!delta(j))
       p[{true, j + 1, k + 1 - j}] = merge_scale * light_paths * kPi * radius * radius *
@@ -320,6 +330,15 @@ std::unique_ptr<BidirGuiding> trained_guiding(const Scene& scene, bool guide_cam
       if (hit(Vec3(0.7f, 0, 0), &si))
         g->record_camera_vertex(uint64_t(i), 1, si.p, si.ng, si.wo, Rgb(0.1f + u(gen)));
     }
+    // Technique counts per radiance leaf (technique_probabilities.h): one leaf in four saw
+    // something, the others took enough samples and saw nothing, so that probabilities below
+    // 1 (the floor) and of 1 both enter the weights, differently per technique.
+    const uint32_t leaves = uint32_t(g->radiance().leaf_count());
+    for (uint32_t leaf = 0; leaf < leaves; ++leaf)
+      for (int t = 0; t < GuidingField::kTechniques; ++t)
+        for (uint32_t j = 0; j < GuidingField::kNeeEvidence; ++j)
+          g->count_technique(GuidingField::Technique(t), leaf,
+                             (leaf * 3 + uint32_t(t)) % 4 == 0 && j % 2 == 0);
     g->end_iteration(scene, photons);
     // Ends the pass (as after its last iteration, 1, 3 or 7): what it learned is sampled next.
     EXPECT_TRUE(g->end_pass_after(first == 0 ? 1 : 2 * first - 1, 0.0, no_variances));
@@ -335,7 +354,7 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
   ScratchArena arena;
   const std::unique_ptr<BidirGuiding> guiding =
       c.guided ? trained_guiding(scene, c.guide_camera, c.guide_light) : nullptr;
-  int guided_vertices = 0;
+  int guided_vertices = 0, reduced_vertices = 0;
   const float light_paths = c.light_paths, radius = 0.02f;
   const bool connect = c.algorithm != BidirAlgorithm::Bpm,
              merge = c.algorithm != BidirAlgorithm::Bpt &&
@@ -383,6 +402,10 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
         EXPECT_TRUE(c.guide_camera || !radiance) << "an unguided camera side has a guide";
         EXPECT_TRUE(c.guide_light || !importance) << "an unguided light side has a guide";
         guided_vertices += (radiance || !c.guide_camera) && (importance || !c.guide_light);
+        const VertexProbabilities q = guiding->probabilities_at(si.p, si.ng);
+        reduced_vertices += q.of(GuidingField::kNextEvent, si.wo) < 1 ||
+                            q.of(GuidingField::kConnection, si.wo) < 1 ||
+                            q.of(GuidingField::kLensConnection, si.wo) < 1;
       }
     }
     ASSERT_NEAR(sum, 1.0, 1e-4) << c.scene << " path " << checked << " with " << weights.size()
@@ -399,6 +422,8 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
   // The guided cases must exercise guided densities: on average a guided vertex per two paths.
   if (guiding) {
     EXPECT_GT(2 * guided_vertices, paths) << c.scene;
+    // ... and learned technique probabilities below 1: on average one vertex in four paths.
+    EXPECT_GT(4 * reduced_vertices, paths) << c.scene;
   }
   std::printf(
       "[ partition ] %-14s %d paths (%d through delta vertices, %d lights seen directly), max "

@@ -450,14 +450,14 @@ TEST(Guiding, NextEventProbabilityDropsWhereNoLightIsSeen) {
   settings.spatial_threshold = 10;
   GuidingField field(Bounds3{{0, 0, 0}, {1, 1, 1}}, settings);
   ASSERT_EQ(field.leaf_count(), 1u);
-  EXPECT_EQ(field.guide(0).nee_probability, 1.f);
+  EXPECT_EQ(field.guide(0).probability[GuidingField::kNextEvent], 1.f);
   field.add_nee_counts({GuidingField::kNeeEvidence, 0});
   field.add_vertex_counts({100});  // the leaf splits at the end of the pass
   field.end_pass(0);
   ASSERT_GT(field.leaf_count(), 1u);
   EXPECT_EQ(field.reduced_nee_leaves(), field.leaf_count());
   for (uint32_t l = 0; l < field.leaf_count(); ++l)
-    EXPECT_EQ(field.guide(l).nee_probability, settings.nee_floor) << l;
+    EXPECT_EQ(field.guide(l).probability[GuidingField::kNextEvent], settings.nee_floor) << l;
   const uint32_t a = field.leaf_at(Vec3(0.1f, 0.1f, 0.1f)),
                  b = field.leaf_at(Vec3(0.9f, 0.9f, 0.9f));
   const uint32_t c = field.leaf_at(Vec3(0.1f, 0.9f, 0.9f));
@@ -468,16 +468,18 @@ TEST(Guiding, NextEventProbabilityDropsWhereNoLightIsSeen) {
   counts[2 * b + 1] = 1;
   field.add_nee_counts(counts);
   field.end_pass(1);
-  EXPECT_EQ(field.guide(a).nee_probability, settings.nee_floor);
-  EXPECT_EQ(field.guide(b).nee_probability, 1.f);
-  EXPECT_EQ(field.guide(c).nee_probability, settings.nee_floor);
+  EXPECT_EQ(field.guide(a).probability[GuidingField::kNextEvent], settings.nee_floor);
+  EXPECT_EQ(field.guide(b).probability[GuidingField::kNextEvent], 1.f);
+  EXPECT_EQ(field.guide(c).probability[GuidingField::kNextEvent], settings.nee_floor);
   // Seeing light in a few of many samples counts as light unless nee_visible_share allows it.
   for (const float share : {0.f, 0.1f}) {
     settings.nee_visible_share = share;
     GuidingField f(Bounds3{{0, 0, 0}, {1, 1, 1}}, settings);
     f.add_nee_counts({1000, 50});
     f.end_pass(0);
-    EXPECT_EQ(f.guide(0).nee_probability, share > 0 ? settings.nee_floor : 1.f) << share;
+    EXPECT_EQ(f.guide(0).probability[GuidingField::kNextEvent],
+              share > 0 ? settings.nee_floor : 1.f)
+        << share;
   }
 }
 
@@ -806,7 +808,7 @@ TEST(TrainingSchedule, TrialRoundsArePooled) {
 
 // Renders `spp` samples per pixel with the render loop (which gives the integrator its budget)
 // and returns its statistics.
-static nlohmann::json render_and_report(const Scene& scene, GuidedPathTracer& integrator, int spp) {
+static nlohmann::json render_and_report(const Scene& scene, Integrator& integrator, int spp) {
   RenderBudget budget;
   budget.spp = spp;
   RenderCallbacks cb;
@@ -1011,6 +1013,45 @@ TEST(GuidedVcm, BothMisWeightingsStayUnbiased) {
       EXPECT_NEAR(x.mean, bpt.mean, 3 * std::hypot(x.standard_error, bpt.standard_error) + bias)
           << name << (guided_mis ? " mixture" : " bsdf");
     }
+}
+
+// guided-bpt and guided-vcm take next event estimation, lens connections and connections with
+// probabilities learned per leaf (bidir/technique_probabilities.h); each count enters the MIS
+// sums and each taken sample divides by its probability. Forced to the floor in every leaf with
+// enough samples (a visible share of 1), the Cornell box's image mean must still agree with
+// bpt's over six seeds, and every technique must have been reduced somewhere.
+TEST(GuidedVcm, TechniqueProbabilitiesKeepTheEstimateUnbiased) {
+  auto scene = make_builtin_scene("cornell", 24, 24);
+  IntegratorSettings s;
+  s.max_depth = 6;
+  s.guiding.nee_floor = 0.25f;
+  s.guiding.nee_visible_share = 1;
+  const auto bpt = test::over_seeds(6, [&](uint64_t seed) {
+    IntegratorSettings plain = s;
+    plain.seed = seed;
+    return test::pixel_stats(test::render_with(*scene, "bpt", 16, plain).image).mean;
+  });
+  for (const BidirAlgorithm algorithm : {BidirAlgorithm::GuidedBpt, BidirAlgorithm::GuidedVcm}) {
+    bidir::BidirIntegrator integrator(algorithm, s);
+    const nlohmann::json stats = render_and_report(*scene, integrator, 16);
+    const nlohmann::json& g = stats["guiding"];
+    for (const char* key :
+         {"nee_reduced_leaves", "lens_connection_reduced_leaves", "connection_reduced_leaves"})
+      EXPECT_GT(g[key].get<size_t>(), 0u) << key;
+    const char* name = algorithm == BidirAlgorithm::GuidedBpt ? "guided-bpt" : "guided-vcm";
+    const auto x = test::over_seeds(6, [&](uint64_t seed) {
+      IntegratorSettings seeded = s;
+      seeded.seed = seed;
+      const auto r = test::render_with(*scene, name, 16, seeded);
+      EXPECT_EQ(r.nonfinite, 0u) << name;
+      return test::pixel_stats(r.image).mean;
+    });
+    std::printf("[ technique floor ] %-10s mean %.5f se %.5f (bpt %.5f se %.5f)\n", name, x.mean,
+                x.standard_error, bpt.mean, bpt.standard_error);
+    const double bias = algorithm == BidirAlgorithm::GuidedVcm ? 0.01 * bpt.mean : 0.0;
+    EXPECT_NEAR(x.mean, bpt.mean, 3 * std::hypot(x.standard_error, bpt.standard_error) + bias)
+        << name;
+  }
 }
 
 // guided-bpt and guided-vcm combine their passes by inverse variance, as guided-pt does: the

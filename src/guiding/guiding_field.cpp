@@ -134,14 +134,15 @@ void GuidingField::add_vertex_counts(const std::vector<uint32_t>& counts) {
   for (size_t i = 0; i < counts.size() && i < counts_.size(); ++i) counts_[i] += counts[i];
 }
 
-void GuidingField::add_nee_counts(const std::vector<uint32_t>& counts) {
-  if (nee_counts_.size() != 2 * leaves_.size()) nee_counts_.assign(2 * leaves_.size(), 0);
-  for (size_t i = 0; i < counts.size() && i < nee_counts_.size(); ++i) nee_counts_[i] += counts[i];
+void GuidingField::add_technique_counts(Technique t, const std::vector<uint32_t>& counts) {
+  std::vector<uint64_t>& mine = technique_counts_[t];
+  if (mine.size() != 2 * leaves_.size()) mine.assign(2 * leaves_.size(), 0);
+  for (size_t i = 0; i < counts.size() && i < mine.size(); ++i) mine[i] += counts[i];
 }
 
-size_t GuidingField::reduced_nee_leaves() const {
+size_t GuidingField::reduced_leaves(Technique t) const {
   size_t n = 0;
-  for (const Leaf& l : leaves_) n += l.nee_probability < 1;
+  for (const Leaf& l : leaves_) n += l.probability[t] < 1;
   return n;
 }
 
@@ -182,8 +183,9 @@ void GuidingField::refresh_guides() {
   }
   for (uint32_t i = 0; i < leaves_.size(); ++i) {
     const Leaf& l = leaves_[i];
-    guides_[i] = {l.sampling.total() > 0 ? &l.sampling : nullptr, bsdf_fraction(i),
-                  l.nee_probability};
+    guides_[i] = {l.sampling.total() > 0 ? &l.sampling : nullptr,
+                  bsdf_fraction(i),
+                  {l.probability[0], l.probability[1], l.probability[2]}};
   }
 }
 
@@ -332,19 +334,24 @@ void GuidingField::split_leaves(int k) {
 }
 
 void GuidingField::end_pass(int k) {
-  if (nee_counts_.size() == 2 * leaves_.size()) {
-    const float floor = std::clamp(settings_.nee_floor, 0.f, 1.f);
+  const float floor = std::clamp(settings_.nee_floor, 0.f, 1.f);
+  for (int t = 0; t < kTechniques; ++t) {
+    std::vector<uint64_t>& counts = technique_counts_[t];
+    if (counts.size() != 2 * leaves_.size()) continue;
+    const double share =
+        t == kConnection ? std::max(settings_.nee_visible_share, settings_.connection_visible_share)
+                         : settings_.nee_visible_share;
     for (size_t i = 0; i < leaves_.size(); ++i) {
-      const uint64_t taken = nee_counts_[2 * i], visible = nee_counts_[2 * i + 1];
-      const bool dark = double(visible) <= double(settings_.nee_visible_share) * double(taken);
+      const uint64_t taken = counts[2 * i], visible = counts[2 * i + 1];
+      const bool dark = double(visible) <= share * double(taken);
       if (!dark) {
-        leaves_[i].nee_probability = 1;
+        leaves_[i].probability[t] = 1;
       } else if (taken >= kNeeEvidence && floor > 0) {
-        leaves_[i].nee_probability = floor;
+        leaves_[i].probability[t] = floor;
       }
     }
+    counts.clear();
   }
-  nee_counts_.clear();
   for (Leaf& l : leaves_) {
     l.recording.propagate();
     l.sampling = std::move(l.recording);
@@ -376,7 +383,9 @@ size_t GuidingField::quadtree_node_count() const {
 
 size_t GuidingField::memory_bytes() const {
   size_t bytes = nodes_.capacity() * sizeof(SpatialNode) + leaves_.capacity() * sizeof(Leaf) +
-                 (counts_.capacity() + nee_counts_.capacity()) * sizeof(uint64_t) +
+                 (counts_.capacity() + technique_counts_[0].capacity() +
+                  technique_counts_[1].capacity() + technique_counts_[2].capacity()) *
+                     sizeof(uint64_t) +
                  guides_.capacity() * sizeof(Guide) + start_.capacity() * sizeof(uint32_t);
   for (const Leaf& l : leaves_) bytes += l.sampling.bytes() + l.recording.bytes();
   return bytes;

@@ -88,10 +88,14 @@ class GuidingField {
   // What a vertex in the leaf samples with, in one small record read per vertex: the learned
   // distribution (nullptr until the leaf has learned radiance) and the BSDF selection
   // probability. Refreshed by splat() and end_pass().
+  // Techniques that a vertex takes with a learned probability (add_technique_counts()): next
+  // event estimation (guided-pt, guided-bpt, guided-vcm), and in the bidirectional core the
+  // lens connection of a light vertex and the connection of a light vertex to a camera vertex.
+  enum Technique : int { kNextEvent = 0, kLensConnection = 1, kConnection = 2, kTechniques = 3 };
   struct Guide {
     const DirectionalQuadtree* distribution = nullptr;
     float bsdf_fraction = 1;
-    float nee_probability = 1;  // see add_nee_counts()
+    float probability[kTechniques] = {1, 1, 1};  // see add_technique_counts()
   };
   const Guide& guide(uint32_t leaf) const { return guides_[leaf]; }
 
@@ -99,17 +103,22 @@ class GuidingField {
   // rule. Every guided vertex counts, whether or not it found radiance (Müller et al. 2017:
   // "path vertices"). Callers count per thread and add the integers in any order.
   void add_vertex_counts(const std::vector<uint32_t>& counts);
-  // Adds next event samples per leaf: counts[2 leaf] light samples taken at the leaf's
-  // vertices, counts[2 leaf + 1] of them unoccluded with a non-zero contribution (callers count
-  // per thread, as above). end_pass() sets the probability of next event estimation of a leaf
-  // that saw light to 1 and of one that took at least kNeeEvidence samples and saw none (at most
-  // GuidingSettings::nee_visible_share of them) to GuidingSettings::nee_floor; a leaf with fewer
-  // samples keeps its probability (children inherit their parent's). A leaf at the floor still
-  // takes light samples: a later pass that sees light there sets it back to 1.
+  // Adds samples of technique t per leaf: counts[2 leaf] taken at the leaf's vertices (for
+  // next event estimation: light samples; for connections: shadow rays), counts[2 leaf + 1] of
+  // them unoccluded with a non-zero contribution (callers count per thread, as above).
+  // end_pass() sets the probability of t at a leaf that saw something to 1 and at one that took
+  // at least kNeeEvidence samples and saw nothing (at most GuidingSettings::nee_visible_share of
+  // them) to GuidingSettings::nee_floor; a leaf with fewer samples keeps its probability
+  // (children inherit their parent's). A leaf at the floor still takes samples: a later pass
+  // that sees something there sets it back to 1.
   static constexpr uint32_t kNeeEvidence = 64;
-  void add_nee_counts(const std::vector<uint32_t>& counts);
-  // The leaves whose next event probability is below 1 (a statistic).
-  size_t reduced_nee_leaves() const;
+  void add_technique_counts(Technique t, const std::vector<uint32_t>& counts);
+  void add_nee_counts(const std::vector<uint32_t>& counts) {
+    add_technique_counts(kNextEvent, counts);
+  }
+  // The leaves whose probability of technique t is below 1 (a statistic).
+  size_t reduced_leaves(Technique t = kNextEvent) const;
+  size_t reduced_nee_leaves() const { return reduced_leaves(kNextEvent); }
   // Records one sample directly (sequential; tests), counting it as a vertex when its
   // statistical weight is positive.
   void record(const GuidingRecord& r);
@@ -145,7 +154,7 @@ class GuidingField {
     DirectionalQuadtree sampling, recording;
     SelectionOptimizer selection;
     double carry_share = 1;  // of its distribution's energy, halved at each split (carry)
-    float nee_probability = 1;
+    float probability[kTechniques] = {1, 1, 1};
   };
   void record_into(Leaf& leaf, const GuidingRecord& r);
   // Splits a leaf node in two at the middle of `axis` (-1: its box's longest axis).
@@ -176,9 +185,10 @@ class GuidingField {
   std::array<int, 3> start_dims_{1, 1, 1};
   Vec3 start_origin_, start_scale_;  // cell coordinates of p: (p - origin) * scale
   std::vector<Leaf> leaves_;
-  std::vector<uint64_t> counts_;      // path vertices per leaf in the current pass
-  std::vector<uint64_t> nee_counts_;  // per leaf: light samples taken, of them seeing light
-  std::vector<Guide> guides_;         // per leaf
+  std::vector<uint64_t> counts_;  // path vertices per leaf in the current pass
+  // Per technique and leaf: samples taken, of them seeing something.
+  std::array<std::vector<uint64_t>, kTechniques> technique_counts_;
+  std::vector<Guide> guides_;  // per leaf
   // Uninitialised storage for splat()'s records grouped by leaf, grown and kept, so that the
   // parallel scatter, not a serial constructor, first touches its pages. A copy starts empty.
   class RecordScratch {

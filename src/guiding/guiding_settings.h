@@ -81,11 +81,21 @@ struct GuidingSettings {
   // samples, none unoccluded with f > 0); everywhere else, and until then, 1. The light
   // sample's density is scaled by the probability in every weight, so the estimate stays
   // unbiased (guided_path_tracer.cpp). 1: next event estimation everywhere, as Müller et al.
+  // guided-bpt / guided-vcm learn the same per leaf for next event estimation, lens
+  // connections and connections, in their MIS sums (bidir/technique_probabilities.h); 1 there:
+  // every technique at every vertex, as bpt / vcm.
   float nee_floor = 0.25f;
   // The share of a leaf's light samples that may see light for it still to count as seeing
   // none (0: not one). Above 0 the floor also reaches leaves where light arrives; the tests use
   // 1 (every leaf with enough samples) to check that the weights stay a partition of unity.
   float nee_visible_share = 0;
+  // guided-bpt / guided-vcm: the same for connections of light vertices to camera vertices
+  // (the larger of the two applies to them). Light that reaches a dark room through a gap is
+  // seen by a few connections from everywhere along the sight lines through it: on door-ajar
+  // (320x240, 64 spp) every radiance leaf in the lit room saw 1-5% of its connections
+  // unoccluded, so with a share of 0 no leaf was reduced. With 5%, 35% fewer rays and 5% less
+  // time at the same relMSE (three seeds); 10% gave 6.5% less time and a 6% higher relMSE.
+  float connection_visible_share = 0.05f;
 };
 
 }  // namespace caustica

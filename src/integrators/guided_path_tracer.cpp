@@ -41,7 +41,7 @@ Mixture mixture_at(const GuidingField& field, const GuidingSettings& settings, b
     mix.guide = guide.distribution;
     mix.bsdf_fraction = guide.bsdf_fraction;
   }
-  mix.nee_probability = guide.nee_probability;
+  mix.nee_probability = guide.probability[GuidingField::kNextEvent];
   mix.leaf = mix.record_leaf = leaf;
   if (!learn) return mix;
   if (settings.cosine_product) mix.cosine_normal = si.shading.n;

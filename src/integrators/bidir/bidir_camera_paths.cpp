@@ -84,6 +84,9 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
 
   Rgb beta(1.f);
   Rgb rr_beta(1.f);  // the throughput BSDF sampling alone would have (guided roulette)
+  // The probability of next event estimation at the previous vertex toward this ray's hit
+  // (technique_probabilities.h): an emitter hit's weight counts that technique with it.
+  float nee_probability_before = 1;
   Vec3 prev_p = ray.o;
   int depth = 0;              // surface vertices so far
   bool specular_path = true;  // every bounce so far was specular
@@ -111,7 +114,8 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     }
     if (!tech_.connect) return specular_path ? 1.f : 0.f;
     weighted = true;
-    terms = terms_emitter_hit(rules, light, lights.pmf(&light), prev_p, ray.d, hit, m);
+    terms = terms_emitter_hit(rules, light, lights.pmf(&light), prev_p, ray.d, hit, m,
+                              nee_probability_before);
     return terms.weight(rules.counts());
   };
 
@@ -147,9 +151,19 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     const bool delta = bsdf.is_delta();
     ++acc.work.camera_vertices;
     const VertexGuides guides = tech_.guided ? guiding_.at(si.p, si.ng, bsdf) : VertexGuides{};
+    const VertexProbabilities probabilities = tech_.guided && !delta
+                                                  ? guiding_.probabilities_at(si.p, si.ng, &guides)
+                                                  : VertexProbabilities{};
+    // dVCM here stands for the technique whose light subpath ends at this vertex and connects
+    // toward wo: to the lens at the first vertex, else to the vertex before (mis.h, scale_vcm).
+    if (probabilities)
+      rules.scale_vcm(
+          mis, probabilities.of(
+                   mis.first ? GuidingField::kLensConnection : GuidingField::kConnection, si.wo));
     if (!delta) {
-      vertex_techniques(scene, it, {si, bsdf, beta, mis, depth, guided_mis() ? guides : kUnguided},
-                        light_path, rng, arena, acc);
+      vertex_techniques(
+          scene, it, {si, bsdf, beta, mis, depth, guided_mis() ? guides : kUnguided, probabilities},
+          light_path, rng, arena, acc);
       // Importance arriving straight from the lens (directly or through specular bounces only)
       // is what light tracing connects to; a light subpath scattered toward it finds nothing.
       if (tech_.guided && !specular_path && guiding_.records_pixel(pixel))
@@ -159,6 +173,8 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     const auto step = scatter_subpath(rules, mis, si, bsdf, guides, TransportMode::Radiance, rng,
                                       beta, rr_beta, guided_mis());
     if (!step) break;
+    nee_probability_before =
+        probabilities ? probabilities.of(GuidingField::kNextEvent, step->wi) : 1.f;
     if (radiance_records && !step->specular && BidirGuiding::guidable(bsdf)) {
       radiance_records->gained(acc.sum);  // what this vertex's techniques found is not its own
       radiance_records->add({si.p, si.ng, step->wi, depth, bsdf.abs_cos(step->wi) / step->pdf,
@@ -208,13 +224,22 @@ void BidirIntegrator::next_event(const Scene& scene, const MisRules& rules, cons
   const Vec2 u = rng.next_2d();
   const auto d = sample_direct_light(scene, v.si, v.bsdf, u_light, u);
   if (!d) return;
+  // Taken with the learned probability of its side (technique_probabilities.h): the draw only
+  // where it is below 1, so that other pixels keep their random numbers.
+  const float q = v.probabilities.of(GuidingField::kNextEvent, d->ls.wi);
+  if (q < 1 && rng.next_float() >= q) return;
   // The shadow ray before the MIS terms: an occluded light costs no densities (a coated
   // BSDF's are random walks). The same contributions are made.
-  if (scene.occluded(d->shadow)) return;
-  const TechniqueTerms terms =
+  const bool occluded = scene.occluded(d->shadow);
+  if (v.probabilities && guiding_.counts_techniques())
+    guiding_.count_technique(GuidingField::kNextEvent, v.probabilities.leaf_toward(d->ls.wi),
+                             !occluded);
+  if (occluded) return;
+  TechniqueTerms terms =
       terms_next_event(rules, *d->light, d->pmf, d->ls, v.si, v.bsdf, v.mis, v.guides);
+  terms.own_factor = rules.mis(q);
   const float w = terms.weight(rules.counts());
-  const Rgb value = v.beta * d->f * d->ls.radiance * (w / (d->pmf * d->ls.pdf_w));
+  const Rgb value = v.beta * d->f * d->ls.radiance * (w / (d->pmf * d->ls.pdf_w * q));
   if (value.is_black()) return;
   acc.add(false, 1, v.depth + 1, value, &terms);
 }
@@ -230,13 +255,13 @@ void BidirIntegrator::connect_to_light_paths(const Scene& scene, const Iteration
   for (int j = 0; j < c; ++j) {
     const uint64_t path =
         j == 0 ? light_path : std::min<uint64_t>(uint64_t(rng.next_float() * double(n)), n - 1);
-    connect_to_light_path(scene, rules, v, scaled, path, j == 0, arena, acc);
+    connect_to_light_path(scene, rules, v, scaled, path, j == 0, rng, arena, acc);
   }
 }
 
 void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& rules,
                                             const CameraVertex& cv, Rgb beta, uint64_t light_path,
-                                            bool own, ScratchArena& arena,
+                                            bool own, Pcg32& rng, ScratchArena& arena,
                                             PixelAccumulator& acc) const {
   const SurfaceInteraction& si = cv.si;
   const Bsdf& bsdf = cv.bsdf;
@@ -273,6 +298,8 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
       rebuilt.guides = guided_mis() && rebuilt.bsdf.valid()
                            ? guiding_.at(rebuilt.si.p, rebuilt.si.ng, rebuilt.bsdf)
                            : VertexGuides{};
+      rebuilt.probabilities = tech_.guided ? guiding_.probabilities_at(rebuilt.si.p, rebuilt.si.ng)
+                                           : VertexProbabilities{};
       rebuilt.built = true;
     }
     const SurfaceInteraction& light_si = rebuilt.si;
@@ -282,6 +309,11 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
     const float dist2 = length_squared(d);
     if (!(dist2 > 0)) continue;
     const Vec3 dir = d / std::sqrt(dist2);
+    // Taken with the light vertex's learned probability toward the camera vertex, decided
+    // before the BSDFs are evaluated (a coated BSDF's f is a random walk).
+    const VertexProbabilities& probabilities = rebuilt.probabilities;
+    const float q = probabilities.of(GuidingField::kConnection, -dir);
+    if (q < 1 && rng.next_float() >= q) continue;
     const Rgb f_camera = bsdf.f(si.wo, dir, TransportMode::Radiance) * bsdf.abs_cos(dir);
     if (f_camera.is_black()) continue;
     const Rgb f_light =
@@ -289,11 +321,16 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
     if (f_light.is_black()) continue;
     ++acc.work.connections;
     // The shadow ray before the MIS terms, as for next event estimation.
-    if (scene.occluded(spawn_ray_between(si, light_si))) continue;
-    const TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si,
-                                                  bsdf, cv.mis, rebuilt.guides, cv.guides);
+    const bool occluded = scene.occluded(spawn_ray_between(si, light_si));
+    if (probabilities && guiding_.counts_techniques())
+      guiding_.count_technique(GuidingField::kConnection, probabilities.leaf_toward(-dir),
+                               !occluded);
+    if (occluded) continue;
+    TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf,
+                                            cv.mis, rebuilt.guides, cv.guides);
+    terms.own_factor = rules.mis(q);
     const float w = terms.weight(rules.counts());
-    const Rgb value = beta * v.throughput * f_camera * f_light * (w / dist2);
+    const Rgb value = beta * v.throughput * f_camera * f_light * (w / (dist2 * q));
     if (value.is_black()) continue;
     acc.add(false, v.depth + 1, depth + 1, value, &terms,
             own ? AdaptivePlan::Share::OwnLightPath : AdaptivePlan::Share::RandomLightPath);

@@ -92,6 +92,7 @@ struct RebuiltLightVertex {
   SurfaceInteraction si;
   Bsdf bsdf;
   VertexGuides guides;
+  VertexProbabilities probabilities;  // of its connections (technique_probabilities.h)
   bool built = false;
 };
 static_assert(std::is_trivially_destructible_v<RebuiltLightVertex>,
@@ -221,8 +222,10 @@ class BidirIntegrator final : public CameraPathIntegrator {
   // t = 1: the light vertex seen through a lens point; splat recorded in the chunk. Returns
   // the connection's unweighted estimate (0 when blocked), what the guiding of light subpaths
   // learns from.
+  // probabilities: the vertex's (technique_probabilities.h), the lens connection's among them.
   Rgb connect_to_camera(const Scene& scene, const Iteration& it, const SurfaceInteraction& si,
-                        const Bsdf& bsdf, const VertexGuides& guides, Rgb beta, const MisSums& mis,
+                        const Bsdf& bsdf, const VertexGuides& guides,
+                        const VertexProbabilities& probabilities, Rgb beta, const MisSums& mis,
                         int depth, Pcg32& rng, LightChunk& chunk) const;
 
   // ---- camera subpaths ----------------------------------------------------------------------
@@ -246,6 +249,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
     const MisSums& mis;
     int depth;
     const VertexGuides& guides;
+    const VertexProbabilities& probabilities;  // its next event estimation's
   };
   void vertex_techniques(const Scene& scene, const Iteration& it, const CameraVertex& v,
                          uint64_t light_path, Pcg32& rng, ScratchArena& arena,
@@ -264,8 +268,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
   // beta: the camera vertex's throughput over the connections per vertex. own: light_path is
   // the pixel's own (its rebuilt vertices are kept in acc for the pixel's other camera vertices).
   void connect_to_light_path(const Scene& scene, const MisRules& rules, const CameraVertex& v,
-                             Rgb beta, uint64_t light_path, bool own, ScratchArena& arena,
-                             PixelAccumulator& acc) const;
+                             Rgb beta, uint64_t light_path, bool own, Pcg32& rng,
+                             ScratchArena& arena, PixelAccumulator& acc) const;
 
   // Merging accepts a photon only if light could have reached the query's surface through it
   // (no leaks through zero-thickness walls):

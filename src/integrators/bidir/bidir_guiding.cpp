@@ -21,6 +21,11 @@ constexpr float kDefaultBsdfFraction = 0.5f;
 void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint64_t pixels,
                            int spp, double seconds) {
   enabled_ = true;
+  count_techniques_ = settings.nee_floor < 1;
+  reduced_any_ = false;
+  for (bool& r : reduced_) r = false;
+  for (TechniqueCounts& counts : technique_counts_)
+    for (std::vector<uint32_t>& c : counts) c.clear();
   guide_camera_ = settings.guide_camera_paths;
   guide_light_ = settings.guide_light_paths;
   using Records = GuidingSettings::RadianceRecords;
@@ -70,8 +75,38 @@ bool BidirGuiding::end_pass_after(uint32_t iteration, double elapsed,
   if (learned) {
     radiance_.end_pass(k);
     importance_.end_pass(k);
+    reduced_any_ = false;
+    for (int t = 0; t < GuidingField::kTechniques; ++t) {
+      reduced_[t] = radiance_.reduced_leaves(GuidingField::Technique(t)) > 0;
+      reduced_any_ = reduced_any_ || reduced_[t];
+    }
   }
   return true;
+}
+
+void BidirGuiding::count_technique(GuidingField::Technique t, uint32_t leaf, bool seen) const {
+  std::vector<uint32_t>& counts = technique_counts_.local()[t];
+  if (counts.size() != 2 * radiance_.leaf_count()) counts.assign(2 * radiance_.leaf_count(), 0);
+  ++counts[2 * leaf];
+  counts[2 * leaf + 1] += seen;
+}
+
+uint32_t VertexProbabilities::leaf_toward(Vec3 w) const {
+  const int side = VertexGuides::side_of(ng, w);
+  if (leaf[side] == kNoLeaf) {
+    if (guides) {
+      guides->guide(TransportMode::Radiance, w);  // resolves the side's leaf, once
+      leaf[side] = guides->leaf[int(TransportMode::Radiance)][side];
+    } else {
+      leaf[side] = fields->probability_leaf(p, side ? -ng : ng);
+    }
+  }
+  return leaf[side];
+}
+
+float VertexProbabilities::of(GuidingField::Technique t, Vec3 w) const {
+  if (!fields || !fields->reduces(t)) return 1.f;
+  return fields->radiance().guide(leaf_toward(w)).probability[t];
 }
 
 // As guided-pt's (guidable_bsdf, guided_mixture.h): layered BSDFs are guided whatever their
@@ -96,7 +131,8 @@ void VertexGuides::resolve(TransportMode mode, int side) const {
   const bool radiance = mode == TransportMode::Radiance;
   if (radiance ? fields->guide_camera_ : fields->guide_light_) {
     const GuidingField& field = radiance ? fields->radiance_ : fields->importance_;
-    const GuidingField::Guide& g = field.guide(field.leaf_at(p, c));
+    leaf[int(mode)][side] = field.leaf_at(p, c);
+    const GuidingField::Guide& g = field.guide(leaf[int(mode)][side]);
     guides[int(mode)][side] = g.distribution;
     bsdf[int(mode)][side] = g.bsdf_fraction;
   }
@@ -159,6 +195,14 @@ void BidirGuiding::learn(GuidingField& field, std::span<const std::span<const Gu
 void BidirGuiding::end_iteration(const Scene& scene,
                                  const std::vector<LightVertex>& light_vertices) {
   if (!schedule_.learning()) return;
+  // The threads' technique counts are integers: their sum does not depend on the threads.
+  for (TechniqueCounts& counts : technique_counts_) {
+    for (int t = 0; t < GuidingField::kTechniques; ++t) {
+      if (counts[t].size() != 2 * radiance_.leaf_count()) continue;
+      radiance_.add_technique_counts(GuidingField::Technique(t), counts[t]);
+      std::fill(counts[t].begin(), counts[t].end(), 0);
+    }
+  }
   if (guide_light_ && importance_from_light_) {
     importance_records_ += light_records_.size();
     learn(importance_, light_records_.runs(), light_stride_);
@@ -216,6 +260,10 @@ void BidirGuiding::report(nlohmann::json& stats) const {
   g["guided_subpaths"] = guide_camera_ && guide_light_ ? "both"
                          : guide_camera_               ? "camera"
                                                        : "light";
+  g["nee_reduced_leaves"] = radiance_.reduced_leaves(GuidingField::kNextEvent);
+  g["lens_connection_reduced_leaves"] = radiance_.reduced_leaves(GuidingField::kLensConnection);
+  g["connection_reduced_leaves"] = radiance_.reduced_leaves(GuidingField::kConnection);
+  g["technique_floor"] = radiance_.settings().nee_floor;
   g["radiance_records"] = radiance_records_;
   g["radiance_learned_from"] = radiance_from_photons_ && radiance_from_camera_ ? "both"
                                : radiance_from_camera_                         ? "camera"

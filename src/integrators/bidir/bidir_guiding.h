@@ -46,6 +46,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
+#include <array>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <vector>
@@ -56,6 +57,7 @@
 #include "image/inverse_variance.h"
 #include "integrators/bidir/light_vertex.h"
 #include "integrators/bidir/subpath_records.h"
+#include "integrators/bidir/technique_probabilities.h"
 #include "integrators/bidir/vertex_guides.h"
 
 namespace caustica {
@@ -89,6 +91,34 @@ class BidirGuiding {
   // The guides at a vertex at p with geometric normal ng and this BSDF (empty where it is not
   // guided).
   VertexGuides at(Vec3 p, Vec3 ng, const Bsdf& bsdf) const;
+  // The learned probabilities of the deterministic techniques at a vertex at p with geometric
+  // normal ng (technique_probabilities.h); empty (all 1) outside guided and training passes.
+  // guides: the vertex's own (at p and ng), whose radiance leaves are shared, or nullptr.
+  VertexProbabilities probabilities_at(Vec3 p, Vec3 ng,
+                                       const VertexGuides* guides = nullptr) const {
+    VertexProbabilities v;
+    if (!reduces() && !counts_techniques()) return v;
+    v.fields = this;
+    v.p = p;
+    v.ng = ng;
+    if (guides && guides->fields && guide_camera_) v.guides = guides;
+    return v;
+  }
+  // Whether a probability can be below 1 in this pass (it samples the fields, and a leaf
+  // learned one).
+  bool reduces() const { return enabled_ && reduced_any_ && schedule_.guided(); }
+  // Whether this pass counts the techniques taken and what they saw (training passes).
+  bool counts_techniques() const { return enabled_ && count_techniques_ && schedule_.learning(); }
+  // A technique taken at `leaf` (VertexProbabilities::leaf_toward) saw something (unoccluded,
+  // a non-zero contribution) or not; from any thread (counts_techniques() only).
+  void count_technique(GuidingField::Technique t, uint32_t leaf, bool seen) const;
+  // The leaf of the radiance field holding p on the side n points to.
+  uint32_t probability_leaf(Vec3 p, Vec3 n) const {
+    return radiance_.leaf_at(p, GuidingField::side_class(n));
+  }
+  // Whether technique t has a probability below 1 anywhere in this pass (else nothing is
+  // looked up for it).
+  bool reduces(GuidingField::Technique t) const { return reduces() && reduced_[t]; }
   // Whether a vertex with this BSDF is guided once its leaf has learned (no delta, near-specular
   // or stochastic lobes: those sample the BSDF alone, as in guided-pt).
   static bool guidable(const Bsdf& bsdf);
@@ -149,6 +179,12 @@ class BidirGuiding {
                     uint64_t stride);
 
   bool enabled_ = false;
+  bool count_techniques_ = false;  // GuidingSettings::nee_floor < 1
+  bool reduced_any_ = false;       // some leaf has a probability below 1
+  bool reduced_[GuidingField::kTechniques] = {false, false, false};  // per technique
+  // Per thread, per technique: counts[2 leaf] taken, counts[2 leaf + 1] seeing something.
+  using TechniqueCounts = std::array<std::vector<uint32_t>, GuidingField::kTechniques>;
+  mutable tbb::enumerable_thread_specific<TechniqueCounts> technique_counts_;
   bool guide_camera_ = true, guide_light_ = true;  // GuidingSettings::guide_*_paths
   bool radiance_from_photons_ = true, radiance_from_camera_ = false;    // ::radiance_records
   bool importance_from_camera_ = true, importance_from_light_ = false;  // ::importance_records

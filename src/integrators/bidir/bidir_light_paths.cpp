@@ -175,6 +175,12 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
     if (depth > max_depth) break;
 
     const VertexGuides guides = tech_.guided ? guiding_.at(si.p, si.ng, bsdf) : VertexGuides{};
+    const VertexProbabilities probabilities = tech_.guided && !bsdf.is_delta()
+                                                  ? guiding_.probabilities_at(si.p, si.ng)
+                                                  : VertexProbabilities{};
+    // dVCM at y1 stands for next event estimation from y1 toward the light (mis.h, scale_vcm).
+    if (depth == 1 && probabilities)
+      it.rules.scale_vcm(mis, probabilities.of(GuidingField::kNextEvent, si.wo));
     if (!bsdf.is_delta()) {
       if (stores_vertices()) {
         chunk.vertices.push_back(
@@ -182,7 +188,7 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
       }
       if (tech_.light_to_camera) {
         const Rgb c = connect_to_camera(scene, it, si, bsdf, guided_mis() ? guides : kUnguided,
-                                        beta, mis, depth, rng, chunk);
+                                        probabilities, beta, mis, depth, rng, chunk);
         if (c.is_finite()) seen += c;
       }
     }
@@ -191,6 +197,9 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
     const auto step = scatter_subpath(it.rules, mis, si, bsdf, guides, TransportMode::Importance,
                                       rng, beta, rr_beta, guided_mis());
     if (!step) break;
+    // dVCM at the next vertex stands for this vertex's connection toward it.
+    if (probabilities && !step->specular)
+      it.rules.scale_vcm(mis, probabilities.of(GuidingField::kConnection, step->wi));
     if (importance_records && !step->specular && BidirGuiding::guidable(bsdf)) {
       importance_records->gained(seen);
       importance_records->add({si.p, si.ng, step->wi, depth, bsdf.abs_cos(step->wi) / step->pdf,
@@ -274,13 +283,18 @@ void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Itera
 
 Rgb BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
                                        const SurfaceInteraction& si, const Bsdf& bsdf,
-                                       const VertexGuides& guides, Rgb beta, const MisSums& mis,
-                                       int depth, Pcg32& rng, LightChunk& chunk) const {
+                                       const VertexGuides& guides,
+                                       const VertexProbabilities& probabilities, Rgb beta,
+                                       const MisSums& mis, int depth, Pcg32& rng,
+                                       LightChunk& chunk) const {
   const Camera& camera = scene.camera();
   const auto cs = camera.sample_wi(si.p, rng.next_2d());
   if (!cs || !(cs->importance > 0)) return Rgb(0.f);
   const Rgb f = bsdf.f(si.wo, cs->wi, TransportMode::Importance) * bsdf.abs_cos(cs->wi);
   if (f.is_black()) return Rgb(0.f);
+  // Taken with the vertex's learned probability toward the lens (technique_probabilities.h).
+  const float q = probabilities.of(GuidingField::kLensConnection, cs->wi);
+  if (q < 1 && rng.next_float() >= q) return Rgb(0.f);
   // Pixel importance is pixel_count * We * f(r - c_p) / integral f; each pixel is estimated by
   // N light paths. Every pixel whose filter support holds the raster point r gets a splat,
   // MIS-weighted against its own camera technique (raster density pdf(r - c_p)).
@@ -288,16 +302,23 @@ Rgb BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
       cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(it.plan.light_paths));
   // The shadow ray before the lens geometry's densities (a coated BSDF's reverse density is a
   // random walk) and the splats' MIS terms: the same splats are made.
-  if (scene.occluded(si.spawn_ray_to(cs->p_lens))) return Rgb(0.f);
+  const bool occluded = scene.occluded(si.spawn_ray_to(cs->p_lens));
+  if (probabilities && guiding_.counts_techniques())
+    guiding_.count_technique(GuidingField::kLensConnection, probabilities.leaf_toward(cs->wi),
+                             !occluded);
+  if (occluded) return Rgb(0.f);
   const LensConnection lens = lens_connection(camera, si, bsdf, si.wo, cs->p_lens, guides);
+  const float scale_taken = scale / q;
   const bool splatted = splat_lens_connection(
       camera, it, cs->raster, TechniqueImages::key(false, depth + 1, 1),
-      [&](float w) { return beta * f * (scale * w); },
+      [&](float w) { return beta * f * (scale_taken * w); },
       [&](const MisRules& rules, float raster_density) {
-        return terms_light_to_camera(rules, lens, mis, raster_density);
+        TechniqueTerms terms = terms_light_to_camera(rules, lens, mis, raster_density);
+        terms.own_factor = rules.mis(q);
+        return terms;
       },
       chunk);
-  return splatted ? beta * f * scale : Rgb(0.f);
+  return splatted ? beta * f * scale_taken : Rgb(0.f);
 }
 
 }  // namespace caustica::bidir

@@ -33,7 +33,7 @@ float others(const TechniqueTerms& t, const MisCounts& n) {
 }  // namespace
 
 float TechniqueTerms::weight(const MisCounts& counts) const {
-  const float own_count = counts.of(own);
+  const float own_count = counts.of(own) * own_factor;
   if (!(own_count > 0)) return 0.f;
   // 1 / (1 + others): an infinite sum of other techniques is the limit weight 0. A NaN can only
   // come from a 0 / 0 inside one pdf ratio, which has no limit to give; it gets weight 0.
@@ -42,7 +42,7 @@ float TechniqueTerms::weight(const MisCounts& counts) const {
 }
 
 float TechniqueTerms::denominator(const MisCounts& counts) const {
-  return counts.of(own) + others(*this, counts);
+  return counts.of(own) * own_factor + others(*this, counts);
 }
 
 MisRules::MisRules(MisHeuristic heuristic, const MisCounts& counts)
@@ -125,6 +125,10 @@ void MisRules::scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev,
   s.vcm = mis(1.f / pdf_fwd);
 }
 
+void MisRules::scale_vcm(MisSums& s, float q) const {
+  if (q != 1.f) s.vcm = times(s.vcm, mis(q));
+}
+
 void MisRules::add_beyond(TechniqueTerms& t, const MisSums& s, TechniqueClass rest_class,
                           float scale, float pdf_rev, bool with_merge_here) const {
   if (with_merge_here) t.merge += scale;
@@ -135,12 +139,13 @@ void MisRules::add_beyond(TechniqueTerms& t, const MisSums& s, TechniqueClass re
   t.merge += times(r, s.merge);
 }
 
-TechniqueTerms MisRules::hit_light(const MisSums& camera, float direct_pdf,
-                                   float emission_pdf) const {
+TechniqueTerms MisRules::hit_light(const MisSums& camera, float direct_pdf, float emission_pdf,
+                                   float nee_probability) const {
   // eqs. 42-43: the light subpath is empty; the camera side holds NEE and everything further.
   TechniqueTerms t;
   t.own = TechniqueClass::Emitter;
   t.emitter = times(mis(direct_pdf), camera.vcm);
+  if (nee_probability != 1.f) t.emitter = times(t.emitter, mis(nee_probability));
   const float e = mis(emission_pdf);
   t.light_trace = times(e, camera.rest);
   t.connect = times(e, camera.conn);

@@ -69,6 +69,10 @@ struct MisSums {
 struct TechniqueTerms {
   TechniqueClass own = TechniqueClass::Connect;
   float emitter = 0, light_trace = 0, connect = 0, merge = 0;
+  // The current technique's own count is its class's times this factor (through mis()): the
+  // learned probability with which its vertex takes it (guided-bpt, guided-vcm; see
+  // MisRules::scale_vcm). The contribution then divides by that probability.
+  float own_factor = 1;
   // The weight under `counts` (mis()'d counts, MisRules::counts()).
   float weight(const MisCounts& counts) const;
   // sum_k n_k p_k / p_current including the current technique: 1 / weight * own count.
@@ -110,11 +114,24 @@ class MisRules {
   void hit(MisSums& s, float dist2, float cos_at_hit) const;
   // Scattering from a vertex: cos_out = |ng . wi| there, pdf_fwd / pdf_rev of the bounce.
   void scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev, bool specular) const;
+  // Techniques taken with a per-vertex probability q (guided-bpt, guided-vcm: next event
+  // estimation, lens connections and connections where training saw them blocked). Their count
+  // is the class's times q of the vertex that takes them, which enters the sums through the
+  // one term that stands for each: a vertex's dVCM. On the camera subpath, dVCM at z_j (after
+  // hit()) stands for the technique whose light subpath ends at z_j and connects to z_(j-1) (a
+  // lens connection at z_1): scaled by that technique's q at z_j. On the light subpath, dVCM
+  // at y1 stands for next event estimation from y1, and dVCM at y_(i+1) (after scatter() at
+  // y_i) for the connection of y_i to y_(i+1): scaled by their q at y1 and y_i. The other
+  // places a probability enters: the own technique (TechniqueTerms::own_factor) and an emitter
+  // hit's next event term (hit_light's nee_probability). q = 1 changes nothing, bit for bit.
+  void scale_vcm(MisSums& s, float q) const;
 
   // The terms of each way a path is completed (eq. 37 with counts); weight = terms.weight().
   // Camera subpath hits an emitter (s = 0): direct_pdf in the measure of light_first_hit
   // (area, or solid angle for infinite lights), emission_pdf = pmf * pdf_pos * pdf_dir.
-  TechniqueTerms hit_light(const MisSums& camera, float direct_pdf, float emission_pdf) const;
+  // nee_probability: that of next event estimation at the vertex before the emitter, toward it.
+  TechniqueTerms hit_light(const MisSums& camera, float direct_pdf, float emission_pdf,
+                           float nee_probability = 1) const;
   // The camera ray itself hits an area light (s = 0, t = 2): the one other technique is the
   // light subpaths' emission point connected to the lens (s = 1, t = 1). emission_pos_pdf:
   // pmf * pdf_pos of that point (area measure); `camera` the sums after hit() at the light.

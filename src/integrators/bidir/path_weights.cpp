@@ -68,6 +68,12 @@ std::vector<TechniqueWeight> production_weights(
   std::vector<VertexGuides> guides(k);
   for (int i = 1; guiding && i < k; ++i)
     guides[i] = guiding->at(x[i], path.surfaces[i - 1].ng, bsdf[i]);
+  // The learned probability of technique t at the non-delta vertex x_i toward w
+  // (technique_probabilities.h), as the renderer looks it up; 1 unguided.
+  auto probability = [&](GuidingField::Technique t, int i, Vec3 w) {
+    if (!guiding || delta(i)) return 1.f;
+    return guiding->probabilities_at(x[i], path.surfaces[i - 1].ng).of(t, w);
+  };
 
   // Light subpath replay: sums at x1..x(k-1), stored and reloaded as the renderer does.
   LightLeSample le;
@@ -80,6 +86,7 @@ std::vector<TechniqueWeight> production_weights(
   for (int i = 1; i < k; ++i) {
     if (i == 1) {
       light_mis[1] = light_subpath_start(rules, light, pmf, le, light_si[1], distance(x[0], x[1]));
+      rules.scale_vcm(light_mis[1], probability(GuidingField::kNextEvent, 1, light_si[1].wo));
     } else {
       MisSums m = light_mis[i - 1];
       const bool specular = delta(i - 1);
@@ -88,6 +95,7 @@ std::vector<TechniqueWeight> production_weights(
                                                      dir(i - 1, i), TransportMode::Importance);
       scatter_update(rules, m, light_si[i - 1], bsdf[i - 1], light_si[i - 1].wo, dir(i - 1, i),
                      TransportMode::Importance, specular, pdf_fwd, guides[i - 1]);
+      rules.scale_vcm(m, probability(GuidingField::kConnection, i - 1, dir(i - 1, i)));
       rules.hit(m, distance_squared(x[i - 1], x[i]), geometric_cos(light_si[i], dir(i, i - 1)));
       light_mis[i] = m;
     }
@@ -104,6 +112,8 @@ std::vector<TechniqueWeight> production_weights(
       rules.camera_start(camera_pdf_w(scene.camera(), x[k], dir(k, k - 1), raster_density));
   rules.hit(camera_mis[k - 1], distance_squared(x[k], x[k - 1]),
             geometric_cos(camera_si[k - 1], dir(k - 1, k)));
+  rules.scale_vcm(camera_mis[k - 1],
+                  probability(GuidingField::kLensConnection, k - 1, camera_si[k - 1].wo));
   for (int i = k - 2; i >= 1; --i) {
     MisSums m = camera_mis[i + 1];
     const bool specular = delta(i + 1);
@@ -113,6 +123,7 @@ std::vector<TechniqueWeight> production_weights(
     scatter_update(rules, m, camera_si[i + 1], bsdf[i + 1], camera_si[i + 1].wo, dir(i + 1, i),
                    TransportMode::Radiance, specular, pdf_fwd, guides[i + 1]);
     rules.hit(m, distance_squared(x[i + 1], x[i]), geometric_cos(camera_si[i], dir(i, i + 1)));
+    rules.scale_vcm(m, probability(GuidingField::kConnection, i, camera_si[i].wo));
     camera_mis[i] = m;
   }
 
@@ -127,6 +138,7 @@ std::vector<TechniqueWeight> production_weights(
                                                    TransportMode::Radiance);
     scatter_update(rules, m, camera_si[1], bsdf[1], camera_si[1].wo, to_light,
                    TransportMode::Radiance, specular, pdf_fwd, guides[1]);
+    const float q = probability(GuidingField::kNextEvent, 1, to_light);
     float w;
     if (finite) {
       SurfaceInteraction emitter;
@@ -134,9 +146,11 @@ std::vector<TechniqueWeight> production_weights(
       emitter.ng = path.light_normal;
       emitter.wo = dir(0, 1);
       rules.hit(m, distance_squared(x[0], x[1]), geometric_cos(emitter, emitter.wo));
-      w = terms_emitter_hit(rules, light, pmf, x[1], to_light, &emitter, m).weight(rules.counts());
+      w = terms_emitter_hit(rules, light, pmf, x[1], to_light, &emitter, m, q)
+              .weight(rules.counts());
     } else {
-      w = terms_emitter_hit(rules, light, pmf, x[1], to_light, nullptr, m).weight(rules.counts());
+      w = terms_emitter_hit(rules, light, pmf, x[1], to_light, nullptr, m, q)
+              .weight(rules.counts());
     }
     out.push_back({false, 0, k + 1, w});
   }
@@ -150,27 +164,27 @@ std::vector<TechniqueWeight> production_weights(
     ls.pdf_w = light.is_delta() ? 1.f : light.pdf_li(x[1], ls.wi, x[0], ls.n_light);
     light.pdf_le(x[0], le.n, -ls.wi, &ls.pdf_emit_pos, &ls.pdf_emit_dir);
     ls.cos_at_light = light.type() == LightType::Area ? abs_dot(path.light_normal, ls.wi) : 1.f;
-    out.push_back(
-        {false, 1, k,
-         terms_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1], guides[1])
-             .weight(rules.counts())});
+    TechniqueTerms terms =
+        terms_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1], guides[1]);
+    terms.own_factor = rules.mis(probability(GuidingField::kNextEvent, 1, to_light));
+    out.push_back({false, 1, k, terms.weight(rules.counts())});
   }
   // 2 <= s <= k - 1: connections of x(s-1) and x(s).
   for (int s = 2; connect && s <= k - 1; ++s) {
     if (delta(s - 1) || delta(s)) continue;
-    out.push_back(
-        {false, s, k + 1 - s,
-         terms_connection(rules, light_si[s - 1], bsdf[s - 1], light_si[s - 1].wo, stored(s - 1),
-                          camera_si[s], bsdf[s], camera_mis[s], guides[s - 1], guides[s])
-             .weight(rules.counts())});
+    TechniqueTerms terms =
+        terms_connection(rules, light_si[s - 1], bsdf[s - 1], light_si[s - 1].wo, stored(s - 1),
+                         camera_si[s], bsdf[s], camera_mis[s], guides[s - 1], guides[s]);
+    terms.own_factor = rules.mis(probability(GuidingField::kConnection, s - 1, dir(s - 1, s)));
+    out.push_back({false, s, k + 1 - s, terms.weight(rules.counts())});
   }
   // t = 1: x(k-1) connected to the lens.
   if (connect && k >= 2 && !delta(k - 1)) {
-    out.push_back({false, k, 1,
-                   terms_light_to_camera(rules, scene.camera(), light_si[k - 1], bsdf[k - 1],
-                                         light_si[k - 1].wo, stored(k - 1), x[k], raster_density,
-                                         guides[k - 1])
-                       .weight(rules.counts())});
+    TechniqueTerms terms = terms_light_to_camera(rules, scene.camera(), light_si[k - 1],
+                                                 bsdf[k - 1], light_si[k - 1].wo, stored(k - 1),
+                                                 x[k], raster_density, guides[k - 1]);
+    terms.own_factor = rules.mis(probability(GuidingField::kLensConnection, k - 1, dir(k - 1, k)));
+    out.push_back({false, k, 1, terms.weight(rules.counts())});
   }
   // Merges at every non-delta interior vertex.
   for (int j = 1; merge && j <= k - 1; ++j) {

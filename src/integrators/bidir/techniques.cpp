@@ -43,7 +43,8 @@ void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteractio
 }
 
 TechniqueTerms terms_emitter_hit(const MisRules& rules, const Light& light, float pmf, Vec3 prev_p,
-                                 Vec3 dir, const SurfaceInteraction* hit, const MisSums& camera) {
+                                 Vec3 dir, const SurfaceInteraction* hit, const MisSums& camera,
+                                 float nee_probability) {
   float pdf_pos = 0, pdf_dir = 0, direct;
   if (hit) {
     light.pdf_le(hit->p, hit->ng, hit->wo, &pdf_pos, &pdf_dir);
@@ -53,7 +54,7 @@ TechniqueTerms terms_emitter_hit(const MisRules& rules, const Light& light, floa
     light.pdf_le({}, {}, -dir, &pdf_pos, &pdf_dir);
     direct = pmf * light.pdf_li(prev_p, dir, {}, {});
   }
-  return rules.hit_light(camera, direct, pmf * pdf_pos * pdf_dir);
+  return rules.hit_light(camera, direct, pmf * pdf_pos * pdf_dir, nee_probability);
 }
 
 TechniqueTerms terms_light_seen_from_lens(const MisRules& rules, const Light& light, float pmf,

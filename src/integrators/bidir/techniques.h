@@ -41,8 +41,10 @@ void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteractio
 // Camera subpath reaches an emitter: an area light at `hit` (seen from prev_p) or, with hit ==
 // nullptr, an infinite light along dir (leaving prev_p). `camera` is the camera sums at the
 // emitter (after hit() for area lights, before it for infinite ones).
+// nee_probability: that of next event estimation at prev_p toward dir (MisRules::hit_light).
 TechniqueTerms terms_emitter_hit(const MisRules& rules, const Light& light, float pmf, Vec3 prev_p,
-                                 Vec3 dir, const SurfaceInteraction* hit, const MisSums& camera);
+                                 Vec3 dir, const SurfaceInteraction* hit, const MisSums& camera,
+                                 float nee_probability = 1);
 // The camera ray hits an area light straight from the lens (s = 0, t = 2): weighted against the
 // light subpaths' emission points connected to the lens (s = 1, t = 1). `camera`: the sums at
 // the light (after hit()).

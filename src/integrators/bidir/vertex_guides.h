@@ -38,6 +38,9 @@ struct VertexGuides {
   // sampling the BSDF instead. Filled for (mode, side) once resolved has bit 2 mode + side.
   mutable const DirectionalQuadtree* guides[2][2] = {{nullptr, nullptr}, {nullptr, nullptr}};
   mutable float bsdf[2][2] = {{1, 1}, {1, 1}};
+  // The field's leaf of each resolved (mode, side) (~0u where its field was not looked up):
+  // technique_probabilities.h shares the radiance leaves.
+  mutable uint32_t leaf[2][2] = {{~0u, ~0u}, {~0u, ~0u}};
   mutable uint8_t resolved = 0;
   // The last guide density evaluated per (mode, side) and its direction: most densities at a
   // vertex are reverse ones at the same direction (the camera vertex's wo for its NEE, every

@@ -29,9 +29,11 @@ void add_guiding_options(CheckedOptions& o, SharedOptions* s) {
            "Guiding: fixed probability in (0, 1] of sampling the BSDF instead of the learned "
            "distribution (default: learned per spatial leaf by Adam, Mueller 2019)");
   o.number("--guiding-nee-floor", &s->guiding.nee_floor, 0, 1, true,
-           "Guiding (guided-pt): probability in (0, 1] of next event estimation at vertices "
-           "whose spatial leaf took 64 or more light samples in a training pass and saw no light "
-           "(default 0.25; 1: at every vertex, as Mueller 2017)");
+           "Guiding: probability in (0, 1] of next event estimation at vertices whose spatial "
+           "leaf took 64 or more light samples in a training pass and saw no light; guided-bpt "
+           "and guided-vcm also of lens connections that saw nothing and of connections of which "
+           "at most 5% were unoccluded, in their MIS weights (default 0.25; 1: every technique "
+           "at every vertex, as Mueller 2017 and bpt/vcm)");
   o.choice("--guiding-filter", &s->guiding_filter, {"on", "off"},
            "Guiding: box-filtered splatting into the spatial and directional trees, on or off "
            "(default on)");

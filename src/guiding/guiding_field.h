@@ -85,13 +85,13 @@ class GuidingField {
   const Bounds3& leaf_box(uint32_t leaf) const { return leaves_[leaf].box; }
   // The probability of sampling the BSDF at the leaf (fixed, or learned: guiding_settings.h).
   float bsdf_fraction(uint32_t leaf) const;
-  // What a vertex in the leaf samples with, in one small record read per vertex: the learned
-  // distribution (nullptr until the leaf has learned radiance) and the BSDF selection
-  // probability. Refreshed by splat() and end_pass().
   // Techniques that a vertex takes with a learned probability (add_technique_counts()): next
   // event estimation (guided-pt, guided-bpt, guided-vcm), and in the bidirectional core the
   // lens connection of a light vertex and the connection of a light vertex to a camera vertex.
   enum Technique : int { kNextEvent = 0, kLensConnection = 1, kConnection = 2, kTechniques = 3 };
+  // What a vertex in the leaf samples with, in one small record read per vertex: the learned
+  // distribution (nullptr until the leaf has learned radiance), the BSDF selection probability
+  // and the techniques' probabilities. Refreshed by splat() and end_pass().
   struct Guide {
     const DirectionalQuadtree* distribution = nullptr;
     float bsdf_fraction = 1;
@@ -108,9 +108,9 @@ class GuidingField {
   // them unoccluded with a non-zero contribution (callers count per thread, as above).
   // end_pass() sets the probability of t at a leaf that saw something to 1 and at one that took
   // at least kNeeEvidence samples and saw nothing (at most GuidingSettings::nee_visible_share of
-  // them) to GuidingSettings::nee_floor; a leaf with fewer samples keeps its probability
-  // (children inherit their parent's). A leaf at the floor still takes samples: a later pass
-  // that sees something there sets it back to 1.
+  // them, for connections at most connection_visible_share) to GuidingSettings::nee_floor; a leaf
+  // with fewer samples keeps its probability (children inherit their parent's). A leaf at the floor
+  // still takes samples: a later pass that sees something there sets it back to 1.
   static constexpr uint32_t kNeeEvidence = 64;
   void add_technique_counts(Technique t, const std::vector<uint32_t>& counts);
   void add_nee_counts(const std::vector<uint32_t>& counts) {

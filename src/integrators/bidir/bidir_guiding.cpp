@@ -22,7 +22,6 @@ void BidirGuiding::prepare(const Bounds3& bounds, GuidingSettings settings, uint
                            int spp, double seconds) {
   enabled_ = true;
   count_techniques_ = settings.nee_floor < 1;
-  reduced_any_ = false;
   for (bool& r : reduced_) r = false;
   for (TechniqueCounts& counts : technique_counts_)
     for (std::vector<uint32_t>& c : counts) c.clear();
@@ -75,11 +74,8 @@ bool BidirGuiding::end_pass_after(uint32_t iteration, double elapsed,
   if (learned) {
     radiance_.end_pass(k);
     importance_.end_pass(k);
-    reduced_any_ = false;
-    for (int t = 0; t < GuidingField::kTechniques; ++t) {
+    for (int t = 0; t < GuidingField::kTechniques; ++t)
       reduced_[t] = radiance_.reduced_leaves(GuidingField::Technique(t)) > 0;
-      reduced_any_ = reduced_any_ || reduced_[t];
-    }
   }
   return true;
 }

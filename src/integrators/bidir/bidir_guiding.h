@@ -106,7 +106,9 @@ class BidirGuiding {
   }
   // Whether a probability can be below 1 in this pass (it samples the fields, and a leaf
   // learned one).
-  bool reduces() const { return enabled_ && reduced_any_ && schedule_.guided(); }
+  bool reduces() const {
+    return enabled_ && (reduced_[0] || reduced_[1] || reduced_[2]) && schedule_.guided();
+  }
   // Whether this pass counts the techniques taken and what they saw (training passes).
   bool counts_techniques() const { return enabled_ && count_techniques_ && schedule_.learning(); }
   // A technique taken at `leaf` (VertexProbabilities::leaf_toward) saw something (unoccluded,
@@ -180,8 +182,8 @@ class BidirGuiding {
 
   bool enabled_ = false;
   bool count_techniques_ = false;  // GuidingSettings::nee_floor < 1
-  bool reduced_any_ = false;       // some leaf has a probability below 1
-  bool reduced_[GuidingField::kTechniques] = {false, false, false};  // per technique
+  // Per technique: some leaf has a probability below 1.
+  bool reduced_[GuidingField::kTechniques] = {false, false, false};
   // Per thread, per technique: counts[2 leaf] taken, counts[2 leaf + 1] seeing something.
   using TechniqueCounts = std::array<std::vector<uint32_t>, GuidingField::kTechniques>;
   mutable tbb::enumerable_thread_specific<TechniqueCounts> technique_counts_;

@@ -5,7 +5,9 @@
 // took about 40% of the render's time. Like guided-pt's next event probability
 // (guiding/guiding_field.h, add_technique_counts), each is learned per spatial leaf of the
 // radiance field during training: a leaf that took at least GuidingField::kNeeEvidence samples
-// of a technique and saw nothing through any gets GuidingSettings::nee_floor, any other 1.
+// of a technique and saw nothing through any gets GuidingSettings::nee_floor, any other 1 (for
+// connections "nothing" is at most GuidingSettings::connection_visible_share of them: light
+// through a gap is seen from everywhere along its sight lines).
 //
 // A technique's probability belongs to the vertex that ends its light subpath (for next event
 // estimation: the camera vertex that samples the light), on the side of that vertex's

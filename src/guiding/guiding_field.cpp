@@ -341,15 +341,22 @@ void GuidingField::end_pass(int k) {
     const double share =
         t == kConnection ? std::max(settings_.nee_visible_share, settings_.connection_visible_share)
                          : settings_.nee_visible_share;
+    // The share of the technique's attempts (samples taken over the probability they were
+    // taken with) that fall in leaves reduced from now on.
+    double attempts = 0, reduced = 0;
     for (size_t i = 0; i < leaves_.size(); ++i) {
       const uint64_t taken = counts[2 * i], visible = counts[2 * i + 1];
+      const double tried = double(taken) / double(leaves_[i].probability[t]);
       const bool dark = double(visible) <= share * double(taken);
       if (!dark) {
         leaves_[i].probability[t] = 1;
       } else if (taken >= kNeeEvidence && floor > 0) {
         leaves_[i].probability[t] = floor;
       }
+      attempts += tried;
+      if (leaves_[i].probability[t] < 1) reduced += tried;
     }
+    reduced_attempt_share_[t] = attempts > 0 ? reduced / attempts : 0;
     counts.clear();
   }
   for (Leaf& l : leaves_) {

@@ -118,6 +118,9 @@ class GuidingField {
   }
   // The leaves whose probability of technique t is below 1 (a statistic).
   size_t reduced_leaves(Technique t = kNextEvent) const;
+  // The share of technique t's attempts in the last training pass that counted it (samples
+  // taken over their probability) made in leaves whose probability is now below 1.
+  double reduced_attempt_share(Technique t) const { return reduced_attempt_share_[t]; }
   size_t reduced_nee_leaves() const { return reduced_leaves(kNextEvent); }
   // Records one sample directly (sequential; tests), counting it as a vertex when its
   // statistical weight is positive.
@@ -188,6 +191,7 @@ class GuidingField {
   std::vector<uint64_t> counts_;  // path vertices per leaf in the current pass
   // Per technique and leaf: samples taken, of them seeing something.
   std::array<std::vector<uint64_t>, kTechniques> technique_counts_;
+  double reduced_attempt_share_[kTechniques] = {0, 0, 0};
   std::vector<Guide> guides_;  // per leaf
   // Uninitialised storage for splat()'s records grouped by leaf, grown and kept, so that the
   // parallel scatter, not a serial constructor, first touches its pages. A copy starts empty.

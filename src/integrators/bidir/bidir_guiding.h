@@ -118,8 +118,8 @@ class BidirGuiding {
   uint32_t probability_leaf(Vec3 p, Vec3 n) const {
     return radiance_.leaf_at(p, GuidingField::side_class(n));
   }
-  // Whether technique t has a probability below 1 anywhere in this pass (else nothing is
-  // looked up for it).
+  // Whether technique t is taken at its learned probabilities in this pass (else they are 1 and
+  // nothing is looked up for it).
   bool reduces(GuidingField::Technique t) const { return reduces() && reduced_[t]; }
   // Whether a vertex with this BSDF is guided once its leaf has learned (no delta, near-specular
   // or stochastic lobes: those sample the BSDF alone, as in guided-pt).
@@ -182,7 +182,9 @@ class BidirGuiding {
 
   bool enabled_ = false;
   bool count_techniques_ = false;  // GuidingSettings::nee_floor < 1
-  // Per technique: some leaf has a probability below 1.
+  // Per technique: its probabilities below 1 apply (they cover at least kMinReducedShare of its
+  // attempts in the last training pass that counted it; else every probability is 1).
+  static constexpr double kMinReducedShare = 0.1;
   bool reduced_[GuidingField::kTechniques] = {false, false, false};
   // Per thread, per technique: counts[2 leaf] taken, counts[2 leaf + 1] seeing something.
   using TechniqueCounts = std::array<std::vector<uint32_t>, GuidingField::kTechniques>;

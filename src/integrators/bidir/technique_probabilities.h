@@ -7,7 +7,9 @@
 // radiance field during training: a leaf that took at least GuidingField::kNeeEvidence samples
 // of a technique and saw nothing through any gets GuidingSettings::nee_floor, any other 1 (for
 // connections "nothing" is at most GuidingSettings::connection_visible_share of them: light
-// through a gap is seen from everywhere along its sight lines).
+// through a gap is seen from everywhere along its sight lines). A technique's probabilities
+// apply only while its reduced leaves hold a real share of its attempts
+// (BidirGuiding::kMinReducedShare): elsewhere the lookups would cost more than they save.
 //
 // A technique's probability belongs to the vertex that ends its light subpath (for next event
 // estimation: the camera vertex that samples the light), on the side of that vertex's

@@ -96,9 +96,9 @@ uint32_t VertexProbabilities::leaf_toward(Vec3 w) const {
     if (guides) {
       guides->guide(TransportMode::Radiance, w);  // resolves the side's leaf, once
       leaf[side] = guides->leaf[int(TransportMode::Radiance)][side];
-    } else {
-      leaf[side] = fields->probability_leaf(p, side ? -ng : ng);
     }
+    // Guides marked resolved without a lookup (as tests set them) hold no leaf.
+    if (leaf[side] == kNoLeaf) leaf[side] = fields->probability_leaf(p, side ? -ng : ng);
   }
   return leaf[side];
 }

@@ -142,6 +142,9 @@ class PretendRank final : public LoneRounds {
   void sum_to_root(std::span<FixedSum>) override {
     ADD_FAILURE() << "a lone pretend rank cannot sum with the others";
   }
+  void all_sum(std::span<FixedSum>) override {
+    ADD_FAILURE() << "a lone pretend rank cannot sum with the others";
+  }
 
  private:
   Film* out_;
@@ -184,9 +187,10 @@ struct ThreadPair {
   std::barrier<> meet;
   const Film* films[2] = {nullptr, nullptr};
   bool stops[2] = {false, false};
-  Film total;        // the final films' sum
-  int sums = 0;      // shared sums of films made (rank 0 counts)
-  int meetings = 0;  // meetings without films (any_stops; rank 0 counts)
+  Film total;             // the final films' sum
+  int sums = 0;           // shared sums of films made (rank 0 counts)
+  int meetings = 0;       // meetings without films (any_stops; rank 0 counts)
+  int learning_sums = 0;  // all_sum calls (rank 0 counts)
   std::span<FixedSum> own_sums[2];
 };
 
@@ -240,6 +244,15 @@ class ThreadRank final : public LoneRounds {
     }
     pair_->meet.arrive_and_wait();  // rank 1's sums stay until rank 0 has read them
   }
+  void all_sum(std::span<FixedSum> sums) override {
+    std::vector<FixedSum> mine(sums.begin(), sums.end());
+    pair_->own_sums[rank_] = mine;
+    pair_->meet.arrive_and_wait();  // both copies are in place
+    EXPECT_EQ(pair_->own_sums[1 - rank_].size(), sums.size());
+    for (size_t i = 0; i < sums.size(); ++i) sums[i] += pair_->own_sums[1 - rank_][i];
+    if (rank_ == 0) ++pair_->learning_sums;
+    pair_->meet.arrive_and_wait();  // both have read before either copy goes
+  }
 
  private:
   ThreadPair* pair_;
@@ -252,7 +265,7 @@ struct PairResult {
   Image image;
   uint32_t iterations[2] = {0, 0};
   bool interrupted[2] = {false, false};
-  int sums = 0, meetings = 0;
+  int sums = 0, meetings = 0, learning_sums = 0;
 };
 PairResult render_on_thread_pair(const Scene& scene, const char* name,
                                  const IntegratorSettings& settings, int spp,
@@ -278,6 +291,7 @@ PairResult render_on_thread_pair(const Scene& scene, const char* name,
   other.join();
   result.sums = pair.sums;
   result.meetings = pair.meetings;
+  result.learning_sums = pair.learning_sums;
   return result;
 }
 
@@ -294,6 +308,9 @@ TEST(RanksRender, AdaptiveVcmOnTwoRanksGivesTheOneProcessImageBitForBit) {
   EXPECT_EQ(pair.iterations[0], 6u);  // its own: 0, 2, ..., 10
   EXPECT_EQ(pair.iterations[1], 6u);
   EXPECT_EQ(pair.sums, 4) << "one sum of the films before each probe: 0, 1, 3, 7";
+  // ... and of the pixel moments of the iterations between probes (4 and 6 on rank 0, 5 on
+  // rank 1 before probe 7), whose measured variance corrects the prediction for the choice.
+  EXPECT_EQ(pair.learning_sums, 4);
   size_t differing = 0;
   for (size_t i = 0; i < pair.image.pixel_count(); ++i)
     if (!(pair.image[i] == single.image[i])) ++differing;

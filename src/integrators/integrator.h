@@ -102,6 +102,13 @@ class Integrator {
   // Whether observe_film() is wanted: else the ranks meet before a shared iteration only to
   // agree whether to stop, without summing their films.
   virtual bool observes_film() const { return false; }
+  // Exact sums an integrator learns from beside the film (adaptive-vcm: the pixel moments of
+  // the iterations since its last probe; empty: none, the default). Before a shared iteration
+  // at a fixed --spp the render loop sums them over the ranks, right after the films, and hands
+  // the sum to observe_learning_sums(); otherwise the integrator reads its own. The span's
+  // length must be the same on every rank.
+  virtual std::span<FixedSum> learning_sums() { return {}; }
+  virtual void observe_learning_sums(std::span<const FixedSum> total) { (void)total; }
 
   // A render split over MPI ranks calls this once on every rank after the last iteration, and
   // adds the returned exact sums over the ranks into rank 0's before image() there, as it adds

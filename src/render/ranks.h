@@ -60,6 +60,10 @@ class Ranks {
   // rank; elsewhere it is left as it was): an integrator's own exact sums beside the film.
   virtual void sum_to_root(std::span<FixedSum> sums) = 0;
 
+  // Collective, on all_sum_films' channel. Replaces `sums` on every rank by its sum over the
+  // ranks (the same length on every rank): an integrator's learning sums beside the film.
+  virtual void all_sum(std::span<FixedSum> sums) = 0;
+
   // Collective. Every rank passes its status (0: ready) and, when it failed, its message. All
   // return the largest status; rank 0 gets in *message the lowest failing rank's message
   // (empty if rank 0 failed itself: it has printed its own).
@@ -90,6 +94,7 @@ class SingleProcess final : public Ranks {
   }
   bool any_stops(bool stop) override { return stop; }
   void sum_to_root(std::span<FixedSum>) override {}
+  void all_sum(std::span<FixedSum>) override {}
   int agree(int status, const std::string&, std::string* message) override {
     message->clear();
     return status;

@@ -123,6 +123,13 @@ class MpiRanks final : public Ranks {
     return any > 0;
   }
 
+  void all_sum(std::span<FixedSum> sums) override {
+    for (size_t at = 0; at < sums.size(); at += kPiece) {
+      const int n = int(std::min(kPiece, sums.size() - at));
+      MPI_Allreduce(MPI_IN_PLACE, sums.data() + at, n, fixed_type_, fixed_add_, learning_);
+    }
+  }
+
   void sum_to_root(std::span<FixedSum> sums) override {
     for (size_t at = 0; at < sums.size(); at += kPiece) {
       const int n = int(std::min(kPiece, sums.size() - at));

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <optional>
 #include <stdexcept>
+#include <vector>
 
 #include "film/film.h"
 #include "render/iteration_dealer.h"
@@ -62,6 +63,11 @@ RenderResult render(const Scene& scene, Integrator& integrator, const RenderBudg
     Film before(film.width(), film.height());
     if (ranks.all_sum_films(film, &before, stopping)) return false;
     integrator.observe_film(before);
+    if (const std::span<FixedSum> mine = integrator.learning_sums(); !mine.empty()) {
+      std::vector<FixedSum> total(mine.begin(), mine.end());
+      ranks.all_sum(total);
+      integrator.observe_learning_sums(total);
+    }
     return true;
   };
   std::optional<Film> scratch;  // the film of other ranks' shared iterations, never read

@@ -58,6 +58,17 @@ constexpr double kPathTracingMargin = 1.05;
 // 0.000586 / 0.000420, 0.000362 / 0.000320; material-spheres 0.000257 / 0.000278, 0.000264 /
 // 0.000276, 0.000253 / 0.000257.
 constexpr double kPathTracingPixelMargin = 1.1;
+// The q-quantile of the finite values (0 if none).
+double finite_quantile(const std::vector<double>& values, double q) {
+  std::vector<double> finite;
+  finite.reserve(values.size());
+  for (double v : values)
+    if (std::isfinite(v)) finite.push_back(v);
+  if (finite.empty()) return 0.0;
+  const size_t at = std::min(finite.size() - 1, size_t(double(finite.size()) * q));
+  std::nth_element(finite.begin(), finite.begin() + at, finite.end());
+  return finite[at];
+}
 
 // The operation costs: the model, or what the probes measured (seconds summed over threads).
 CostModel costs_of(const ProbeWork& w, bool measured) {
@@ -302,7 +313,8 @@ void add_counts(ProbeWork& total, const ProbeWork& w) {
   total.photons += w.photons;
 }
 
-void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means) {
+void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means,
+                                const std::vector<double>& measured, double iterations) {
   ++probes_;
   // The light-tracing sums (2 bytes per pixel and candidate) are only needed while a probe
   // renders; released before the choice, so that its buffers do not add to them.
@@ -312,8 +324,43 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   work_.camera_seconds += w.camera_seconds;
   work_.connect_seconds += w.connect_seconds;
   work_.merge_seconds += w.merge_seconds;
+  if (measured.size() == pixels_ && means.size() == pixels_ && chosen_j_ < kCandidates)
+    check_last_choice(measured, iterations, means);
   // A choice needs the film's means (from the iterations before the probe) and two probes.
   if (means.size() == pixels_ && (probes_ >= kFirstProbes || probe_all_)) choose(means);
+}
+
+void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double iterations,
+                                     const std::vector<float>& means) {
+  // The measured relative variance, pooled as the prediction was; both capped at the
+  // prediction's 99.5th percentile, so that a firefly that one segment happened to render (or
+  // that the prediction's winsorising took out) does not decide the factor alone.
+  std::vector<double> relative(pixels_);
+  for (size_t p = 0; p < pixels_; ++p)
+    relative[p] = measured[p] / (double(means[p]) * means[p] + kRelEps);
+  relative = box_blur(relative, width_, height_, kBlurRadius);
+  const double cap = finite_quantile(chosen_variance_, kWinsorize);
+  std::vector<std::array<double, 2>> blocks((pixels_ + kPixelBlock - 1) / kPixelBlock);
+  for_pixel_blocks(pixels_, [&](size_t b, size_t begin, size_t end) {
+    std::array<double, 2> sum{};
+    for (size_t p = begin; p < end; ++p) {
+      if (!std::isfinite(chosen_variance_[p]) || !std::isfinite(relative[p])) continue;
+      sum[0] += std::min(relative[p], cap);
+      sum[1] += std::min(chosen_variance_[p], cap);
+    }
+    blocks[b] = sum;
+  });
+  double measured_total = 0, predicted_total = 0;
+  for (const std::array<double, 2>& sum : blocks) {
+    measured_total += sum[0];
+    predicted_total += sum[1];
+  }
+  checks_.push_back({{"after_probe", probes_},
+                     {"light_path_factor", candidates()[chosen_j_].light_path_factor},
+                     {"connections", candidates()[chosen_j_].connections},
+                     {"iterations", iterations},
+                     {"measured_relative_variance", measured_total / double(pixels_)},
+                     {"predicted_relative_variance", predicted_total / double(pixels_)}});
 }
 
 double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means) const {
@@ -378,6 +425,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   Score best, path_tracing;
   size_t best_j = 0;
   std::vector<PixelMode> modes(pixels_), best_modes(pixels_, PixelMode::PathTrace);
+  std::vector<double> variances(pixels_), best_variances(pixels_), pt_variances;
   nlohmann::json table = nlohmann::json::array();
   // Candidates come in (no merge, merge) pairs after path tracing at index 0.
   for (size_t j = 0; j < k; j += (j == 0 ? 1 : 2)) {
@@ -413,6 +461,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
           pixel_cost = traced;
           modes[p] = PixelMode::PathTrace;
         }
+        variances[p] = v;
         if (std::isfinite(v))
           sum[0] += v;
         else
@@ -445,13 +494,18 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
       best = score;
       best_j = j;
       best_modes = modes;
+      best_variances = variances;
     }
+    if (j == 0) pt_variances = variances;
   }
   if (best_j != 0 && path_tracing.missing == best.missing &&
       path_tracing.value <= kPathTracingMargin * best.value) {
     best_j = 0;
     std::fill(best_modes.begin(), best_modes.end(), PixelMode::PathTrace);
+    best_variances = pt_variances;
   }
+  chosen_j_ = best_j;
+  chosen_variance_ = std::move(best_variances);
   const Candidate& c = list[best_j];
   chosen_ = {};
   chosen_.light_paths = uint64_t(std::llround(double(c.light_path_factor) * pixels));
@@ -482,6 +536,7 @@ void AdaptivePlan::report(nlohmann::json& stats) const {
   a["merge_fraction"] = fraction_of(modes_, PixelMode::Merge);
   a["path_trace_fraction"] = fraction_of(modes_, PixelMode::PathTrace);
   a["history"] = history_;
+  a["checks"] = checks_;
   // The masks, block-averaged to at most 64 x 64 cells.
   const int block = std::max(1, (std::max(width_, height_) + 63) / 64);
   const int cw = (width_ + block - 1) / block, ch = (height_ + block - 1) / block;

@@ -21,6 +21,7 @@
 #include "integrators/bidir/hash_grid.h"
 #include "integrators/bidir/light_path_assignment.h"
 #include "integrators/bidir/light_vertex.h"
+#include "integrators/bidir/segment_moments.h"
 #include "integrators/bidir/technique_images.h"
 #include "integrators/bidir/techniques.h"
 #include "integrators/camera_path.h"
@@ -177,6 +178,13 @@ class BidirIntegrator final : public CameraPathIntegrator {
   void observe_film(const Film& before) override {
     observed_means_ = pixel_means(before);
     observed_ = true;
+  }
+  // adaptive-vcm: the pixel moments of the iterations since the last probe (segment_moments.h).
+  std::span<FixedSum> learning_sums() override {
+    return tech_.adaptive ? segment_.sums() : std::span<FixedSum>();
+  }
+  void observe_learning_sums(std::span<const FixedSum> total) override {
+    observed_segment_.assign(total.begin(), total.end());
   }
 
  private:
@@ -347,6 +355,10 @@ class BidirIntegrator final : public CameraPathIntegrator {
   // The pixel means observe_film() was given for the next probe (else the probe reads its film).
   std::vector<float> observed_means_;
   bool observed_ = false;
+  // The pixel moments of the iterations that rendered the current choice, and their sum over
+  // the ranks that observe_learning_sums() was given for the next probe (empty: read segment_).
+  SegmentMoments segment_;
+  std::vector<FixedSum> observed_segment_;
 };
 
 }  // namespace caustica::bidir

@@ -93,6 +93,7 @@ void BidirIntegrator::prepare(const Scene& scene, Film& film) {
                          settings_.bidir.probe_every_iteration);
   if (tech_.adaptive && !techniques_.enabled())
     path_tracer_ = std::make_unique<PathTracer>(settings_);
+  if (tech_.adaptive) segment_.reset(film.pixel_count());
 }
 
 void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, Film& film) {
@@ -132,7 +133,17 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   if (path_tracer_ && n == 0 && !it.plan.probe) ++path_tracing_iterations_;
   // Before this iteration adds anything: the film adds estimates to its totals as they come.
   std::vector<float> means_before;
-  if (it.plan.probe) means_before = observed_ ? std::move(observed_means_) : pixel_means(film);
+  std::vector<double> measured;  // the variance the last choice showed, per pixel
+  double measured_iterations = 0;
+  if (it.plan.probe) {
+    means_before = observed_ ? std::move(observed_means_) : pixel_means(film);
+    measured = SegmentMoments::variances(
+        observed_segment_.empty() ? segment_.sums() : observed_segment_, &measured_iterations);
+    segment_.clear();
+    observed_segment_.clear();
+  } else if (tech_.adaptive) {
+    segment_.begin_iteration(film);
+  }
   observed_ = false;
 
   const auto light_start = std::chrono::steady_clock::now();
@@ -168,7 +179,9 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
     probe_.light_seconds = light_chunk_seconds_;
     if (probe_.light_seconds == 0) probe_.light_seconds = light_seconds;
     if (probe_.camera_seconds == 0) probe_.camera_seconds = seconds_since(camera_start);
-    plan_.finish_probe(probe_, means_before);
+    plan_.finish_probe(probe_, means_before, measured, measured_iterations);
+  } else if (tech_.adaptive) {
+    segment_.end_iteration(film);
   }
 
   ++iterations_;

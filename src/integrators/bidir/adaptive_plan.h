@@ -139,7 +139,7 @@ class AdaptivePlan {
   // (SegmentMoments; empty if fewer than two): reported beside what was predicted for that
   // choice ("checks"), not used to choose. A few iterations measure a heavy tail low (13 scenes
   // at 160 pixels wide, 64 spp: measured / predicted 0.08-1.14 after 3 iterations, 0.80-1.26
-  // after 31 except water-caustic's 1.5), so a correction from them would keep a choice that
+  // after 31 except water-caustic's 1.64), so a correction from them would keep a choice that
   // happened to render well.
   void finish_probe(const ProbeWork& work, const std::vector<float>& means,
                     const std::vector<double>& measured = {}, double iterations = 0);

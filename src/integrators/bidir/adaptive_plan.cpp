@@ -334,7 +334,7 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
                                      const std::vector<float>& means) {
   // The measured relative variance, pooled as the prediction was; both capped at the
   // prediction's 99.5th percentile, so that a firefly that one segment happened to render (or
-  // that the prediction's winsorising took out) does not decide the factor alone.
+  // that the prediction's winsorising took out) does not decide the comparison alone.
   std::vector<double> relative(pixels_);
   for (size_t p = 0; p < pixels_; ++p)
     relative[p] = measured[p] / (double(means[p]) * means[p] + kRelEps);

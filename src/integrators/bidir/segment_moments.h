@@ -1,12 +1,12 @@
 // adaptive-vcm's measurement of what it chose: the pixel moments of the iterations that render
-// one choice (those between two probes), so that the next choice can set the variance the probes
+// one choice (those between two probes), so that the report can set the variance the probes
 // predicted for that configuration against the variance it showed (AdaptivePlan::finish_probe).
 //
 // An iteration's estimate of a pixel is the film's total after it minus before it (every
 // camera sample and light-tracing splat of the iteration, exactly). The sums are exact (fixed
 // point, core/fixed_sum.h): under MPI every rank adds the iterations it owns, and the sum over
 // the ranks (Integrator::learning_sums) is the sum one process makes, so every rank measures the
-// same variances and makes the same choice.
+// same variances and reports what one process reports.
 #pragma once
 
 #include <span>

@@ -299,7 +299,7 @@ TEST(PbrtSharedScenes, CornellCausticsLoadsAndProjectsLikePbrtV4) {
 
 TEST(PbrtSharedScenes, EveryOwnSceneLoads) {
   for (const char* name : {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic",
-                           "mis-plates", "sun-glass"}) {
+                           "mis-plates", "point-room", "sun-glass"}) {
     SCOPED_TRACE(name);
     test::captured_warnings().clear();
     std::unique_ptr<Scene> scene;
@@ -343,7 +343,7 @@ TEST(PbrtSharedScenes, EveryThirdPartySceneLoads) {
 // lit image (the loader produced something an integrator can use).
 TEST(PbrtSharedScenes, OwnScenesRenderWithPt) {
   for (const char* name : {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic",
-                           "mis-plates", "sun-glass"}) {
+                           "mis-plates", "point-room", "sun-glass"}) {
     SCOPED_TRACE(name);
     auto scene = load_pbrt(shared(std::string(name) + ".pbrt"), test::capture_warning);
     IntegratorSettings settings;

@@ -173,6 +173,11 @@ double fraction_of(const std::vector<PixelMode>& modes, PixelMode mode) {
              : double(std::count(modes.begin(), modes.end(), mode)) / double(modes.size());
 }
 
+void add_roulette_diff(uint8_t* diff, const AdaptivePlan::CandidateSums& sums) {
+  for (size_t j = 0; j < AdaptivePlan::kCandidates; ++j)
+    if (std::isfinite(sums.u[j])) put_float24(diff + 3 * j, get_float24(diff + 3 * j) + sums.u[j]);
+}
+
 MisCounts counts_of(const AdaptivePlan::Candidate& c, size_t pixels, float radius) {
   MisCounts n;
   n.emitter = 1;
@@ -201,8 +206,10 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
       measured_(measured_costs),
       probe_all_(probe_every_iteration),
       moments_(pixels_ * kCandidates * 3, 0),  // float24 zeros
+      roulette_diff_(pixels_ * kCandidates * 3, 0),
       modes_(pixels_, PixelMode::Merge) {
   chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
+  roulette_.fill(1.0);
 }
 
 bool AdaptivePlan::is_probe(uint32_t iteration) const {
@@ -269,6 +276,10 @@ void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* t
     // How often g^2 enters the moment (pixel_end): a random light path's connection c' - 1
     // times.
     const float squares = share == Share::RandomLightPath ? own_count[j] - 1 : 1.f;
+    // The candidate's own techniques' estimate of this sample's part of its diagonal: n'_t
+    // samples where the probe took n_t (roulette_diff_).
+    const float own_g = value * ratio;
+    sums.u[j] += own_g * own_g * (own_count[j] * inv_own) - f2 * ratio;
     sum[j] += g;
     sums.d[j] = (sums.d[j] + f2 * ratio - squares * g * g) +
                 (made ? 0.f : std::numeric_limits<float>::infinity());
@@ -284,6 +295,7 @@ void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTer
   uint8_t* m = &moments_[pixel * kCandidates * 3];
   for (size_t j = 0; j < kCandidates; ++j)
     put_float24(m + 3 * j, get_float24(m + 3 * j) + sums.d[j]);
+  add_roulette_diff(&roulette_diff_[pixel * kCandidates * 3], sums);
 }
 
 AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
@@ -301,6 +313,7 @@ void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums) {
                          c * (c - 1) * s0 * s1 + sums.d[j];
     put_float24(m + 3 * j, get_float24(m + 3 * j) + moment);
   }
+  add_roulette_diff(&roulette_diff_[pixel * kCandidates * 3], sums);
 }
 
 void add_counts(ProbeWork& total, const ProbeWork& w) {
@@ -366,7 +379,34 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
 double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means) const {
   const double mean = means[p];
   const double moment = get_float24(&moments_[(p * kCandidates + j) * 3]) / double(probes_);
-  return std::max(moment - mean * mean, 0.0) / (mean * mean + kRelEps);
+  return std::max(moment - mean * mean, 0.0) / (mean * mean + kRelEps) * roulette_[j];
+}
+
+void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
+  roulette_.fill(1.0);
+  // Per candidate (in parallel; each in pixel order, so deterministic): the sum of its finite
+  // relative variances and of the relative roulette differences, these winsorised at their
+  // 99.5th percentile as the shared variance is (the own techniques' estimate is heavy-tailed:
+  // on a 32 x 32 Cornell box path tracing's factor ranged 1.15-1.43 over the probes without it,
+  // against 1.07 from 400 probes).
+  tbb::parallel_for(size_t(0), kCandidates, [&](size_t j) {
+    std::vector<double> diff(pixels_);
+    double variance = 0;
+    for (size_t p = 0; p < pixels_; ++p) {
+      const double v = relative_variance(p, j, means);
+      diff[p] = std::numeric_limits<double>::infinity();
+      if (!std::isfinite(v)) continue;
+      variance += v;
+      diff[p] = get_float24(&roulette_diff_[(p * kCandidates + j) * 3]) /
+                (double(probes_) * (double(means[p]) * means[p] + kRelEps));
+    }
+    const double cap = finite_quantile(diff, kWinsorize);
+    double total = 0;
+    for (double d : diff)
+      if (std::isfinite(d)) total += std::min(d, cap);
+    const double factor = variance > 0 ? 1.0 + total / variance : 1.0;
+    roulette_[j] = std::isfinite(factor) ? std::max(factor, 1.0) : 1.0;
+  });
 }
 
 std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<float>& means) const {
@@ -410,6 +450,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
                      work_.light_paths > 0 ? work_.light_vertices / work_.light_paths : 0.0,
                      work_.merge_queries / (probes * pixels), work_.photons / (probes * pixels)};
   const CostModel t = costs_of(work_, measured_);
+  update_roulette_factors(means);
   const std::vector<double> correction = shared_firefly_correction(means);
   const std::vector<double> pt = relative_variances(0, means, correction);
   // Candidates compare by the pixels where their variance is infinite (energy they would miss:
@@ -488,6 +529,8 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
                      {"relative_variance_all_merge", variance1 / pixels},
                      {"cost_us_per_pixel", total_cost / pixels},
                      {"pixels_missing_energy", missing},
+                     {"roulette_factor", roulette_[j]},
+                     {"roulette_factor_merge", j == 0 ? roulette_[j] : roulette_[j + 1]},
                      {"score", score.value}});
     if (j == 0) path_tracing = score;
     if (score < best) {

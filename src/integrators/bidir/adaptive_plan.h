@@ -119,8 +119,10 @@ class AdaptivePlan {
   static constexpr size_t kCandidates = 41;
   static constexpr int kProbeConnections = 2;  // the pixel's own light path and a random one
   enum class Share { None, OwnLightPath, RandomLightPath };  // of a connection
+  // u: the Russian-roulette difference (roulette_diff_): sum over contributions of
+  // G_i^2 (n'_t / n_t) - F_i^2 Q_i / Q'_i.
   struct CandidateSums {
-    std::array<float, kCandidates> r{}, s0{}, s1{}, d{};
+    std::array<float, kCandidates> r{}, s0{}, s1{}, d{}, u{};
   };
   // radius: the probe's merge radius (the candidates' merge counts N' pi r^2).
   void begin_probe(float radius);
@@ -158,8 +160,10 @@ class AdaptivePlan {
   static const std::vector<Candidate>& candidates();
 
  private:
-  // Pixel p's relative variance per iteration under candidate j.
+  // Pixel p's relative variance per iteration under candidate j (times roulette_[j]).
   double relative_variance(size_t p, size_t j, const std::vector<float>& means) const;
+  // Sets roulette_ from the sums so far (see roulette_diff_).
+  void update_roulette_factors(const std::vector<float>& means);
   // Per pixel: what to add to every candidate's variance to winsorise the part they share.
   std::vector<double> shared_firefly_correction(const std::vector<float>& means) const;
   // Per pixel: candidate j's relative variance, corrected and pooled over neighbours.
@@ -180,6 +184,21 @@ class AdaptivePlan {
   // from where a sum stops growing. Not bfloat16: 2^-8 would lose a pixel's variance in the
   // rounding of its mean^2, and its sums would stall after a few hundred terms.
   std::vector<uint8_t> moments_;
+  // Russian roulette. The balance weights leave it out (mis.h), so a contribution is
+  // F = f / (Q rho_t), rho_t the survival probability of its own subpaths, and the proxy
+  // F^2 Q / Q' estimates the integral of f^2 sum_t (n_t p_t / rho_t) / (Q Q'): the probe's
+  // mixture of 1 / rho where the candidate has its own, sum_k (n'_k p_k / rho_k) / Q'^2. A
+  // candidate without the probe's connections (short subpaths, rho near 1) leans on long
+  // ones: with throughput roulette its variance was under-predicted by 7-16% (cornell,
+  // point-room at 40 x 30; without roulette within 2%). The contributions of the candidate's
+  // own techniques, G_i^2 (n'_t / n_t), estimate its diagonal without that error, but only
+  // from the samples of those techniques (a heavy tail where they are poor). So per pixel and
+  // candidate this keeps their difference from the proxy (float24, as moments_), and each
+  // choice scales candidate j's relative variances by roulette_[j] = 1 + (the image's sum of
+  // that difference, relative) / (the image's sum of its relative variances), at least 1:
+  // the proxy's spatial detail, the own techniques' total.
+  std::vector<uint8_t> roulette_diff_;
+  std::array<double, kCandidates> roulette_;
   // pixels x candidates: this probe's light-tracing R, in bfloat16 while the probe renders. A
   // pixel gets a few splats per probe, so the sum keeps 2^-8 relative precision, far below the
   // sampling noise of one probe's second-moment estimate.

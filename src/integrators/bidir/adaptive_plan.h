@@ -86,6 +86,9 @@ struct ProbeWork {
   double light_seconds = 0, camera_seconds = 0, connect_seconds = 0, merge_seconds = 0;
 };
 
+// The fraction of pixels in `mode` (0 for no pixels).
+double fraction_of(const std::vector<PixelMode>& modes, PixelMode mode);
+
 // Adds w's operation counts (not its seconds) to total.
 void add_counts(ProbeWork& total, const ProbeWork& w);
 

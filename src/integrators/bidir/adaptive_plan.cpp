@@ -379,7 +379,8 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
 double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means) const {
   const double mean = means[p];
   const double moment = get_float24(&moments_[(p * kCandidates + j) * 3]) / double(probes_);
-  return std::max(moment - mean * mean, 0.0) / (mean * mean + kRelEps) * roulette_[j];
+  // Signed: clamped only after pooling (relative_variances).
+  return (moment - mean * mean) / (mean * mean + kRelEps) * roulette_[j];
 }
 
 void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
@@ -438,7 +439,9 @@ std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector
   for_pixel_blocks(pixels_, [&](size_t, size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p) v[p] = relative_variance(p, j, means) + correction[p];
   });
-  return box_blur(v, width_, height_, kBlurRadius);
+  v = box_blur(v, width_, height_, kBlurRadius);
+  for (double& x : v) x = std::max(x, 0.0);  // inf stays inf
+  return v;
 }
 
 void AdaptivePlan::choose(const std::vector<float>& means) {

@@ -163,7 +163,10 @@ class AdaptivePlan {
   static const std::vector<Candidate>& candidates();
 
  private:
-  // Pixel p's relative variance per iteration under candidate j (times roulette_[j]).
+  // Pixel p's relative variance per iteration under candidate j (times roulette_[j]), signed:
+  // the second moment of a few probes minus the film's mean^2 is often negative where the
+  // variance is small beside mean^2, and a clamp per pixel would bias it up by that noise
+  // (relative_variances clamps after pooling).
   double relative_variance(size_t p, size_t j, const std::vector<float>& means) const;
   // Sets roulette_ from the sums so far (see roulette_diff_).
   void update_roulette_factors(const std::vector<float>& means);

@@ -271,7 +271,16 @@ TEST(AdaptiveVcm, PathTracingIterationsRunPathTracersEstimator) {
   const auto& costs = a["history"].back()["costs_us"];
   EXPECT_LT(costs["path_tracing_vertex"].get<double>(), costs["camera_vertex"].get<double>());
   // The core's work is averaged over the iterations it rendered (the probes) only.
-  EXPECT_GT(stats["bidir"]["work_per_iteration"]["light_paths"].get<double>(), 1000.0);
+  const auto& work = stats["bidir"]["work_per_iteration"];
+  EXPECT_GT(work["light_paths"].get<double>(), 1000.0);
+  // Every light vertex was a ray's hit; the rays that left the box are not vertices.
+  EXPECT_GT(work["light_rays"].get<double>(), work["light_vertices"].get<double>());
+  // The probes are 6 of 32 iterations but most of the time: each renders the core with two
+  // connections per camera vertex and prices 41 candidates, the others path trace.
+  const double probe_share = a["probe_time_fraction"].get<double>();
+  EXPECT_GT(probe_share, 6.0 / 32.0);
+  EXPECT_LE(probe_share, 1.0);
+  EXPECT_GT(a["probe_seconds"].get<double>(), 0.0);
 }
 
 // The plan alone, fed by hand: every pixel of a 16 x 16 image gets a sample every candidate

@@ -232,7 +232,7 @@ IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
 }
 
 void AdaptivePlan::begin_probe(float radius) {
-  light_sums_.assign(pixels_ * kCandidates, to_bfloat16(0.f));
+  light_sums_.assign(pixels_ * kLightSums * kCandidates, to_bfloat16(0.f));
   const std::vector<Candidate>& list = candidates();
   for (size_t j = 0; j < kCandidates; ++j) {
     const MisCounts n = counts_of(list[j], pixels_, radius);
@@ -290,18 +290,22 @@ void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTer
                                    const MisCounts& counts) {
   CandidateSums sums = pixel_start(pixel);
   add(sums, value, terms, counts);
-  uint16_t* stored = &light_sums_[pixel * kCandidates];
-  for (size_t j = 0; j < kCandidates; ++j) stored[j] = to_bfloat16(sums.r[j]);
-  uint8_t* m = &moments_[pixel * kCandidates * 3];
-  for (size_t j = 0; j < kCandidates; ++j)
-    put_float24(m + 3 * j, get_float24(m + 3 * j) + sums.d[j]);
-  add_roulette_diff(&roulette_diff_[pixel * kCandidates * 3], sums);
+  uint16_t* stored = &light_sums_[pixel * kLightSums * kCandidates];
+  for (size_t j = 0; j < kCandidates; ++j) {
+    stored[j] = to_bfloat16(sums.r[j]);
+    stored[kCandidates + j] = to_bfloat16(sums.d[j]);
+    stored[2 * kCandidates + j] = to_bfloat16(sums.u[j]);
+  }
 }
 
 AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
   CandidateSums sums;
-  const uint16_t* stored = &light_sums_[pixel * kCandidates];
-  for (size_t j = 0; j < kCandidates; ++j) sums.r[j] = from_bfloat16(stored[j]);
+  const uint16_t* stored = &light_sums_[pixel * kLightSums * kCandidates];
+  for (size_t j = 0; j < kCandidates; ++j) {
+    sums.r[j] = from_bfloat16(stored[j]);
+    sums.d[j] = from_bfloat16(stored[kCandidates + j]);
+    sums.u[j] = from_bfloat16(stored[2 * kCandidates + j]);
+  }
   return sums;
 }
 
@@ -319,6 +323,7 @@ void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums) {
 void add_counts(ProbeWork& total, const ProbeWork& w) {
   total.light_paths += w.light_paths;
   total.light_vertices += w.light_vertices;
+  total.light_rays += w.light_rays;
   total.camera_vertices += w.camera_vertices;
   total.nondelta_camera_vertices += w.nondelta_camera_vertices;
   total.connections += w.connections;
@@ -329,7 +334,7 @@ void add_counts(ProbeWork& total, const ProbeWork& w) {
 void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means,
                                 const std::vector<double>& measured, double iterations) {
   ++probes_;
-  // The light-tracing sums (2 bytes per pixel and candidate) are only needed while a probe
+  // The light-tracing sums (6 bytes per pixel and candidate) are only needed while a probe
   // renders; released before the choice, so that its buffers do not add to them.
   std::vector<uint16_t>().swap(light_sums_);
   add_counts(work_, w);

@@ -80,6 +80,7 @@ struct IterationPlan {
 // Work counted in a probe iteration and, if measured, the seconds spent.
 struct ProbeWork {
   double light_paths = 0, light_vertices = 0;
+  double light_rays = 0;  // every bounce of the light subpaths (delta ones are not vertices)
   double camera_vertices = 0, nondelta_camera_vertices = 0;
   double connections = 0;  // light vertices a camera vertex was connected to
   double merge_queries = 0, photons = 0;
@@ -205,9 +206,13 @@ class AdaptivePlan {
   // the proxy's spatial detail, the own techniques' total.
   std::vector<uint8_t> roulette_diff_;
   std::array<double, kCandidates> roulette_;
-  // pixels x candidates: this probe's light-tracing R, in bfloat16 while the probe renders. A
-  // pixel gets a few splats per probe, so the sum keeps 2^-8 relative precision, far below the
-  // sampling noise of one probe's second-moment estimate.
+  // pixels x (R, D, U) x candidates: this probe's light-tracing sums, in bfloat16 while the
+  // probe renders; the pixel's camera pass starts from them (pixel_start), so they reach the
+  // moments with its own. A pixel gets a few splats per probe, so each sum keeps about 2^-8
+  // relative precision, far below the sampling noise of one probe's second-moment estimate.
+  // (Adding each splat's D and U to the float24 moments at once, in the light pass's serial
+  // stage, was a quarter of a probe's time on cornell-caustics.)
+  static constexpr size_t kLightSums = 3;
   std::vector<uint16_t> light_sums_;
   // The candidates' counts per class for this probe's radius (structure of arrays).
   struct CountTable {

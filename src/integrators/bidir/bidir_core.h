@@ -69,6 +69,7 @@ struct LightChunk {
   std::vector<Splat> splats;
   std::vector<TechniqueTerms> splat_terms;  // probe iterations: each splat's MIS terms
   uint64_t nonfinite = 0;
+  uint64_t rays = 0;   // rays traced (every bounce, delta ones too)
   double seconds = 0;  // probe iterations: time spent tracing the chunk
 };
 
@@ -331,6 +332,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
   double grid_seconds_total_ = 0;    // of seconds_total_, building the hash grid
   double light_seconds_total_ = 0;   // of seconds_total_, tracing light paths (with their splats)
   double camera_seconds_total_ = 0;  // of seconds_total_, tracing camera paths
+  double probe_seconds_total_ = 0;   // of seconds_total_, adaptive-vcm's probe iterations
   ProbeWork work_total_;             // operations counted over all iterations (counts only)
   std::vector<std::string> technique_files_;
 
@@ -344,7 +346,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
   // adaptive-vcm: the plan, and the work of the current probe iteration.
   mutable AdaptivePlan plan_;
-  ProbeWork probe_;  // this iteration's work
+  ProbeWork probe_;          // this iteration's work
+  uint64_t light_rays_ = 0;  // this iteration's light-subpath rays (append_chunk)
   mutable tbb::enumerable_thread_specific<ProbeWork> pixel_work_;
   // adaptive-vcm's path-tracing iterations (no light paths, not a probe) are rendered by pt's
   // own estimator: the same image in expectation, about 1.25x cheaper than the core's camera

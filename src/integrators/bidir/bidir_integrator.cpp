@@ -174,6 +174,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
     }
   }
   probe_.light_vertices = double(vertices_.size());
+  probe_.light_rays = double(light_rays_);
   add_counts(work_total_, probe_);
   if (it.plan.probe) {
     probe_.light_seconds = light_chunk_seconds_;
@@ -187,7 +188,10 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   ++iterations_;
   last_radius_ = it.radius;
   vertices_total_ += vertices_.size();
-  seconds_total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  seconds_total_ += seconds;
+  if (it.plan.probe) probe_seconds_total_ += seconds;
 }
 
 void BidirIntegrator::finish(const Scene& scene, Film& film) {
@@ -212,6 +216,10 @@ void BidirIntegrator::report(nlohmann::json& stats) const {
   if (tech_.adaptive) {
     plan_.report(stats);
     stats["adaptive"]["path_tracer_iterations"] = path_tracing_iterations_;
+    // The probes' share of the render's time (what the choice costs).
+    stats["adaptive"]["probe_seconds"] = probe_seconds_total_;
+    stats["adaptive"]["probe_time_fraction"] =
+        seconds_total_ > 0 ? probe_seconds_total_ / seconds_total_ : 0.0;
   }
   if (tech_.guided) {
     guiding_.report(stats);
@@ -243,6 +251,7 @@ void BidirIntegrator::report(nlohmann::json& stats) const {
   b["work_per_iteration"] = {
       {"light_paths", work_total_.light_paths * per},
       {"light_vertices", work_total_.light_vertices * per},
+      {"light_rays", work_total_.light_rays * per},
       {"camera_vertices", work_total_.camera_vertices * per},
       {"nondelta_camera_vertices", work_total_.nondelta_camera_vertices * per},
       {"connections", work_total_.connections * per},

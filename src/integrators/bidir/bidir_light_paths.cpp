@@ -38,6 +38,7 @@ void BidirIntegrator::trace_light_paths(const Scene& scene, const Iteration& it,
   vertices_.clear();
   path_begin_.resize(it.plan.light_paths + 1);
   light_chunk_seconds_ = 0;
+  light_rays_ = 0;
   if (tech_.light_to_camera) {
     if (splat_image_.width() != film.width()) splat_image_ = Image(film.width(), film.height());
     std::fill(splat_image_.pixels().begin(), splat_image_.pixels().end(), Rgb(0.f));
@@ -92,6 +93,7 @@ void BidirIntegrator::trace_chunk(const Scene& scene, const Iteration& it, uint6
   chunk.splats.clear();
   chunk.splat_terms.clear();
   chunk.nonfinite = 0;
+  chunk.rays = 0;
   const auto chunk_start = std::chrono::steady_clock::now();
   chunk.first_path = c * chunk_paths_;
   const uint64_t last = std::min<uint64_t>(chunk.first_path + chunk_paths_, it.plan.light_paths);
@@ -117,6 +119,7 @@ void BidirIntegrator::append_chunk(const Iteration& it, const LightChunk& chunk)
   for (size_t i = 0; i < chunk.path_ends.size(); ++i)
     path_begin_[chunk.first_path + i] = base + (i ? chunk.path_ends[i - 1] : 0);
   light_chunk_seconds_ += chunk.seconds;
+  light_rays_ += chunk.rays;
   for (size_t i = 0; i < chunk.splats.size(); ++i) {
     const Splat& s = chunk.splats[i];
     splat_image_[s.pixel] += s.value;
@@ -157,6 +160,7 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
   int depth = 0;
   for (;;) {
     SurfaceInteraction si;
+    ++chunk.rays;
     if (!scene.intersect(ray, &si)) break;
     segment += si.t;
     Bsdf bsdf;

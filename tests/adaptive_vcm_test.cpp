@@ -273,10 +273,11 @@ TEST(AdaptiveVcm, PathTracingIterationsRunPathTracersEstimator) {
   // The core's work is averaged over the iterations it rendered (the probes) only.
   const auto& work = stats["bidir"]["work_per_iteration"];
   EXPECT_GT(work["light_paths"].get<double>(), 1000.0);
-  // Every light vertex was a ray's hit; the rays that left the box are not vertices.
+  // Every light vertex was a ray's hit; a path's last ray, which hit nothing or went past the
+  // maximum depth, is not a vertex.
   EXPECT_GT(work["light_rays"].get<double>(), work["light_vertices"].get<double>());
-  // The probes are 6 of 32 iterations but most of the time: each renders the core with two
-  // connections per camera vertex and prices 41 candidates, the others path trace.
+  // The probes are 6 of 32 iterations but more than that share of the time: each renders the
+  // core with two connections per camera vertex and prices 41 candidates; the others path trace.
   const double probe_share = a["probe_time_fraction"].get<double>();
   EXPECT_GT(probe_share, 6.0 / 32.0);
   EXPECT_LE(probe_share, 1.0);

@@ -23,9 +23,10 @@ namespace {
 float scalar(Rgb v) { return (v.r + v.g + v.b) / 3.f; }
 
 // Mean over pixels of var_p / (mean_p^2 + 0.01) of one iteration's estimate, from `iterations`
-// independent iterations (each in its own film).
+// independent iterations (each in its own film); stride > 1: over the pixels a probe of that
+// stride records (AdaptivePlan's grid) only.
 double measured_relative_variance(const Scene& scene, const std::string& integrator,
-                                  IntegratorSettings s, int iterations) {
+                                  IntegratorSettings s, int iterations, int stride = 1) {
   const int w = scene.camera().width(), h = scene.camera().height();
   auto in = make_integrator(integrator, s);
   Film first(w, h);
@@ -42,14 +43,17 @@ double measured_relative_variance(const Scene& scene, const std::string& integra
       sum2[p] += v * v;
     }
   }
-  double rel = 0;
+  double rel = 0, count = 0;
+  const int offset = (stride - 1) / 2;
   for (size_t p = 0; p < sum.size(); ++p) {
+    if (int(p % w) % stride != offset || int(p / w) % stride != offset) continue;
     const double mean = sum[p] / iterations;
     const double var =
         std::max(sum2[p] / iterations - mean * mean, 0.0) * iterations / (iterations - 1);
     rel += var / (mean * mean + 0.01);
+    count += 1;
   }
-  return rel / double(sum.size());
+  return rel / count;
 }
 
 // The statistics of adaptive-vcm after `iterations` iterations on the scene.
@@ -400,4 +404,125 @@ TEST(AdaptiveVcm, ReportShowsTheChosenCandidateNotTheLowestScore) {
   EXPECT_NE(html.find("0.222"), std::string::npos) << html;
   EXPECT_EQ(html.find("0.111"), std::string::npos) << html;
   EXPECT_NE(html.find("70.0%"), std::string::npos) << html;  // the path-traced share
+}
+
+// On a large image a probe records one pixel per block (AdaptivePlan::kProbePixels): those
+// render the probe's configuration, the others the last choice. The probed pixels alone must
+// predict what rendering a configuration shows there, as a probe of every pixel does
+// (PredictedVarianceMatchesRenderingTheConfiguration); the pixels between them change the
+// light paths' MIS weights of none of them.
+TEST(AdaptiveVcm, ProbesOfEverySecondPixelPredictWhatRenderingShows) {
+  auto scene = make_builtin_scene("cornell", 40, 40);
+  IntegratorSettings s;
+  s.max_depth = 4;
+  s.seed = 5;
+  s.bidir.probe_stride = 2;
+  const auto table = predicted(*scene, s, 200);
+  const int pixels = 1600;
+  struct Config {
+    const char* integrator;
+    float factor;
+    int connections;
+    bool merge;
+  };
+  for (const Config& c : {Config{"pt", 0.f, 0, false}, Config{"vcm", 1.f, 1, true},
+                          Config{"bpt", 2.f, 4, false}, Config{"bpt", 0.25f, 0, false}}) {
+    IntegratorSettings r = s;
+    r.seed = 77;
+    r.mis = MisHeuristic::Balance;
+    r.bidir.light_paths = uint64_t(c.factor * pixels);
+    r.bidir.connections = c.connections;
+    const double measured = measured_relative_variance(*scene, c.integrator, r, 400, 2);
+    const Prediction p = table.at({c.factor, c.connections});
+    const double prediction = c.merge ? p.all_merge : p.no_merge;
+    std::printf(
+        "[ adaptive ] stride 2: %s N = %.2f P, %d connections: predicted %.4f measured %.4f\n",
+        c.integrator, c.factor, c.connections, prediction, measured);
+    EXPECT_NEAR(prediction / measured, 1.0, 0.07)
+        << c.integrator << " " << c.factor << " " << c.connections;
+  }
+}
+
+// The stride follows the image's size, and what a probe of every second pixel does: the probed
+// pixels merge and make the probe's two connections; the others take the last choice, with
+// the probe's light paths; the image is the same for one and two threads.
+TEST(AdaptiveVcm, ProbesOfLargeImagesRecordOnePixelPerBlock) {
+  EXPECT_EQ(bidir::AdaptivePlan(160, 120, false).probe_stride(), 1);
+  EXPECT_EQ(bidir::AdaptivePlan(512, 512, false).probe_stride(), 2);
+  EXPECT_EQ(bidir::AdaptivePlan(640, 480, false).probe_stride(), 2);
+  EXPECT_EQ(bidir::AdaptivePlan(1920, 1080, false).probe_stride(), 7);
+  EXPECT_EQ(bidir::AdaptivePlan(3, 400000, false).probe_stride(), 3);  // at most the narrow side
+
+  auto scene = make_builtin_scene("cornell-glass", 30, 24);
+  IntegratorSettings s;
+  s.max_depth = 6;
+  s.seed = 3;
+  s.bidir.probe_stride = 3;
+  bidir::AdaptivePlan plan(30, 24, false, false, 3);
+  const bidir::IterationPlan probe = plan.plan(0);
+  EXPECT_TRUE(probe.probe);
+  EXPECT_EQ(probe.light_paths, 720u);
+  int recorded = 0;
+  for (size_t p = 0; p < 720; ++p) {
+    const bool r = probe.records(p);
+    recorded += r;
+    EXPECT_EQ(r, (p % 30) % 3 == 1 && (p / 30) % 3 == 1) << p;
+    EXPECT_TRUE(probe.merges(p));  // before a choice: full VCM everywhere
+    EXPECT_FALSE(probe.path_traces(p));
+    EXPECT_EQ(probe.connections_at(p), r ? 2 : 1);
+  }
+  EXPECT_EQ(recorded, 10 * 8);
+
+  const RenderResult one = test::render_with(*scene, "adaptive-vcm", 16, s, 1);
+  const RenderResult two = test::render_with(*scene, "adaptive-vcm", 16, s, 2);
+  size_t differing = 0;
+  for (size_t i = 0; i < one.image.pixel_count(); ++i)
+    if (!(one.image[i] == two.image[i])) ++differing;
+  EXPECT_EQ(differing, 0u);
+  // The choice was made on the 10 x 8 grid and covers every pixel.
+  const nlohmann::json stats = adaptive_stats(*scene, s, 16);
+  const auto& mask = stats["adaptive"]["merge_mask"];
+  EXPECT_EQ(mask["width"].get<int>() * mask["block"].get<int>(), 30);
+}
+
+// Sparse probes keep the image unbiased: every pixel, probed or not, weights its techniques by
+// its own counts. As RegistryAgreement.AgreesWithPathTracing (registry_oracles_test.cpp), on the
+// glossy Cornell box with every iteration a probe of one pixel per 2 x 2 block: the average of
+// two renders differs from pt's by no more than their noise explains.
+TEST(AdaptiveVcm, SparseProbesAgreeWithPathTracing) {
+  auto scene = make_builtin_scene("cornell-glossy", 32, 32);
+  IntegratorSettings s;
+  s.max_depth = 5;
+  s.bidir.radius = 0.01f;
+  auto render_seed = [&](const std::string& name, int n, uint64_t seed, bool sparse) {
+    IntegratorSettings t = s;
+    t.seed = seed;
+    if (sparse) {
+      t.bidir.probe_stride = 2;
+      t.bidir.probe_every_iteration = true;
+    }
+    return test::render_with(*scene, name, n, t).image;
+  };
+  auto normalised_diff = [](const Image& a, const Image& b, const Image& ref) {
+    double sum = 0;
+    for (size_t i = 0; i < a.pixel_count(); ++i)
+      for (int c = 0; c < 3; ++c)
+        sum += std::pow(double(a[i][c]) - b[i][c], 2) / (std::pow(double(ref[i][c]), 2) + 0.01);
+    return sum / (3.0 * a.pixel_count());
+  };
+  auto average = [](const Image& a, const Image& b) {
+    Image out = a;
+    for (size_t i = 0; i < out.pixel_count(); ++i) out[i] = (a[i] + b[i]) * 0.5f;
+    return out;
+  };
+  const Image pt_a = render_seed("pt", 128, 1, false), pt_b = render_seed("pt", 128, 2, false);
+  const Image x_a = render_seed("adaptive-vcm", 32, 3, true),
+              x_b = render_seed("adaptive-vcm", 32, 4, true);
+  const Image pt_avg = average(pt_a, pt_b), x_avg = average(x_a, x_b);
+  const double expected =
+      (normalised_diff(pt_a, pt_b, pt_avg) + normalised_diff(x_a, x_b, pt_avg)) / 4;
+  const double diff = normalised_diff(x_avg, pt_avg, pt_avg);
+  std::printf("[ adaptive ] sparse probes against pt: diff %.5f, expected from noise %.5f\n", diff,
+              expected);
+  EXPECT_LT(diff, 1.5 * expected);
 }

@@ -324,6 +324,28 @@ TEST(RanksRender, AdaptiveVcmOnTwoRanksGivesTheOneProcessImageBitForBit) {
   EXPECT_GT(differing, 0u);
 }
 
+// The same with probes of one pixel in each 2 x 2 block (the stride of images of more than
+// AdaptivePlan::kProbePixels pixels), whose other pixels render the last choice.
+TEST(RanksRender, AdaptiveVcmWithSparseProbesOnTwoRanksGivesTheOneProcessImage) {
+  auto scene = make_builtin_scene("cornell-glass", 24, 20);
+  IntegratorSettings settings;
+  settings.seed = 7;
+  settings.bidir.probe_stride = 2;
+  const int spp = 12;
+  const RenderResult single = test::render_with(*scene, "adaptive-vcm", spp, settings);
+  const PairResult pair = render_on_thread_pair(*scene, "adaptive-vcm", settings, spp);
+  size_t differing = 0;
+  for (size_t i = 0; i < pair.image.pixel_count(); ++i)
+    if (!(pair.image[i] == single.image[i])) ++differing;
+  EXPECT_EQ(differing, 0u);
+  settings.bidir.probe_stride = 1;  // and the stride changes the image
+  const RenderResult dense = test::render_with(*scene, "adaptive-vcm", spp, settings);
+  differing = 0;
+  for (size_t i = 0; i < dense.image.pixel_count(); ++i)
+    if (!(dense.image[i] == single.image[i])) ++differing;
+  EXPECT_GT(differing, 0u);
+}
+
 // The guided integrators' training passes are shared: every rank renders them, so every rank
 // learns the same fields and decides the same schedule; only the final pass is split. guided-pt
 // weights its passes by their inverse variance, so rank 0 adds the ranks' sums of its final

@@ -39,6 +39,9 @@ struct BidirSettings {
   bool measured_costs = false;
   // adaptive-vcm: every iteration is a probe (studies of the variance prediction, tests).
   bool probe_every_iteration = false;
+  // adaptive-vcm: probes record one pixel per probe_stride x probe_stride block (0: from the
+  // image's size, AdaptivePlan::kProbePixels).
+  int probe_stride = 0;
 };
 
 // Settings shared by all integrators, and each family's own struct.

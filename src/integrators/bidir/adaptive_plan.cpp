@@ -199,17 +199,36 @@ const std::vector<AdaptivePlan::Candidate>& AdaptivePlan::candidates() {
   return list;
 }
 
-AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool probe_every_iteration)
+AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool probe_every_iteration,
+                           int probe_stride)
     : pixels_(size_t(width) * size_t(height)),
       width_(width),
       height_(height),
       measured_(measured_costs),
       probe_all_(probe_every_iteration),
-      moments_(pixels_ * kCandidates * 3, 0),  // float24 zeros
-      roulette_diff_(pixels_ * kCandidates * 3, 0),
       modes_(pixels_, PixelMode::Merge) {
+  if (probe_stride <= 0) probe_stride = int(std::floor(std::sqrt(double(pixels_) / kProbePixels)));
+  stride_ = uint32_t(std::clamp(probe_stride, 1, std::max(1, std::min(width, height))));
+  offset_ = (stride_ - 1) / 2;
+  // The grid pixel (gx, gy) is the image pixel (gx s + o, gy s + o).
+  grid_w_ = width > 0 ? int((uint32_t(width) - 1 - offset_) / stride_ + 1) : 0;
+  grid_h_ = height > 0 ? int((uint32_t(height) - 1 - offset_) / stride_ + 1) : 0;
+  grid_pixels_ = size_t(grid_w_) * size_t(grid_h_);
+  moments_.assign(grid_pixels_ * kCandidates * 3, 0);  // float24 zeros
+  roulette_diff_.assign(grid_pixels_ * kCandidates * 3, 0);
   chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
   roulette_.fill(1.0);
+}
+
+template <typename T>
+std::vector<T> AdaptivePlan::on_grid(const std::vector<T>& image) const {
+  if (stride_ == 1 || image.size() != pixels_) return image;
+  std::vector<T> grid(grid_pixels_);
+  for (int gy = 0; gy < grid_h_; ++gy)
+    for (int gx = 0; gx < grid_w_; ++gx)
+      grid[size_t(gy) * grid_w_ + gx] =
+          image[size_t(gy * stride_ + offset_) * width_ + (gx * stride_ + offset_)];
+  return grid;
 }
 
 bool AdaptivePlan::is_probe(uint32_t iteration) const {
@@ -218,12 +237,26 @@ bool AdaptivePlan::is_probe(uint32_t iteration) const {
 }
 
 IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
-  if (is_probe(iteration)) {
+  if (is_probe(iteration) && stride_ == 1) {
     IterationPlan p;
     p.light_paths = pixels_;
     p.connections = kProbeConnections;
+    p.probe_connections = kProbeConnections;
     p.merge_everywhere = true;
     p.probe = true;
+    return p;
+  }
+  if (is_probe(iteration)) {
+    // The probed pixels need the probe's light paths; the others render the last choice
+    // with them.
+    IterationPlan p = chosen_;
+    p.modes = &modes_;
+    p.light_paths = pixels_;
+    p.probe = true;
+    p.probe_stride = stride_;
+    p.probe_offset = offset_;
+    p.width = uint32_t(width_);
+    p.probe_connections = kProbeConnections;
     return p;
   }
   IterationPlan p = chosen_;
@@ -232,7 +265,7 @@ IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
 }
 
 void AdaptivePlan::begin_probe(float radius) {
-  light_sums_.assign(pixels_ * kLightSums * kCandidates, to_bfloat16(0.f));
+  light_sums_.assign(grid_pixels_ * kLightSums * kCandidates, to_bfloat16(0.f));
   const std::vector<Candidate>& list = candidates();
   for (size_t j = 0; j < kCandidates; ++j) {
     const MisCounts n = counts_of(list[j], pixels_, radius);
@@ -290,7 +323,7 @@ void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTer
                                    const MisCounts& counts) {
   CandidateSums sums = pixel_start(pixel);
   add(sums, value, terms, counts);
-  uint16_t* stored = &light_sums_[pixel * kLightSums * kCandidates];
+  uint16_t* stored = &light_sums_[grid_index(pixel) * kLightSums * kCandidates];
   for (size_t j = 0; j < kCandidates; ++j) {
     stored[j] = to_bfloat16(sums.r[j]);
     stored[kCandidates + j] = to_bfloat16(sums.d[j]);
@@ -300,7 +333,7 @@ void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTer
 
 AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
   CandidateSums sums;
-  const uint16_t* stored = &light_sums_[pixel * kLightSums * kCandidates];
+  const uint16_t* stored = &light_sums_[grid_index(pixel) * kLightSums * kCandidates];
   for (size_t j = 0; j < kCandidates; ++j) {
     sums.r[j] = from_bfloat16(stored[j]);
     sums.d[j] = from_bfloat16(stored[kCandidates + j]);
@@ -310,14 +343,15 @@ AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
 }
 
 void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums) {
-  uint8_t* m = &moments_[pixel * kCandidates * 3];
+  const size_t g = grid_index(pixel);
+  uint8_t* m = &moments_[g * kCandidates * 3];
   for (size_t j = 0; j < kCandidates; ++j) {
     const float c = table_.connect[j], r = sums.r[j], s0 = sums.s0[j], s1 = sums.s1[j];
     const float moment = r * r + 2 * r * (s0 + (c - 1) * s1) + s0 * s0 + (c - 1) * s1 * s1 +
                          c * (c - 1) * s0 * s1 + sums.d[j];
     put_float24(m + 3 * j, get_float24(m + 3 * j) + moment);
   }
-  add_roulette_diff(&roulette_diff_[pixel * kCandidates * 3], sums);
+  add_roulette_diff(&roulette_diff_[g * kCandidates * 3], sums);
 }
 
 void add_counts(ProbeWork& total, const ProbeWork& w) {
@@ -342,10 +376,12 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   work_.camera_seconds += w.camera_seconds;
   work_.connect_seconds += w.connect_seconds;
   work_.merge_seconds += w.merge_seconds;
-  if (measured.size() == pixels_ && means.size() == pixels_ && chosen_j_ < kCandidates)
-    check_last_choice(measured, iterations, means);
+  if (means.size() != pixels_) return;
+  const std::vector<float> grid_means = on_grid(means);
+  if (measured.size() == pixels_ && chosen_j_ < kCandidates)
+    check_last_choice(on_grid(measured), iterations, grid_means);
   // A choice needs the film's means (from the iterations before the probe) and two probes.
-  if (means.size() == pixels_ && (probes_ >= kFirstProbes || probe_all_)) choose(means);
+  if (probes_ >= kFirstProbes || probe_all_) choose(grid_means);
 }
 
 void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double iterations,
@@ -353,13 +389,13 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
   // The measured relative variance, pooled as the prediction was; both capped at the
   // prediction's 99.5th percentile, so that a firefly that one segment happened to render (or
   // that the prediction's winsorising took out) does not decide the comparison alone.
-  std::vector<double> relative(pixels_);
-  for (size_t p = 0; p < pixels_; ++p)
+  std::vector<double> relative(grid_pixels_);
+  for (size_t p = 0; p < grid_pixels_; ++p)
     relative[p] = measured[p] / (double(means[p]) * means[p] + kRelEps);
-  relative = box_blur(relative, width_, height_, kBlurRadius);
+  relative = box_blur(relative, grid_w_, grid_h_, kBlurRadius);
   const double cap = finite_quantile(chosen_variance_, kWinsorize);
-  std::vector<std::array<double, 2>> blocks((pixels_ + kPixelBlock - 1) / kPixelBlock);
-  for_pixel_blocks(pixels_, [&](size_t b, size_t begin, size_t end) {
+  std::vector<std::array<double, 2>> blocks((grid_pixels_ + kPixelBlock - 1) / kPixelBlock);
+  for_pixel_blocks(grid_pixels_, [&](size_t b, size_t begin, size_t end) {
     std::array<double, 2> sum{};
     for (size_t p = begin; p < end; ++p) {
       if (!std::isfinite(chosen_variance_[p]) || !std::isfinite(relative[p])) continue;
@@ -377,8 +413,8 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
                      {"light_path_factor", candidates()[chosen_j_].light_path_factor},
                      {"connections", candidates()[chosen_j_].connections},
                      {"iterations", iterations},
-                     {"measured_relative_variance", measured_total / double(pixels_)},
-                     {"predicted_relative_variance", predicted_total / double(pixels_)}});
+                     {"measured_relative_variance", measured_total / double(grid_pixels_)},
+                     {"predicted_relative_variance", predicted_total / double(grid_pixels_)}});
 }
 
 double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means) const {
@@ -396,9 +432,9 @@ void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
   // on a 32 x 32 Cornell box path tracing's factor ranged 1.15-1.43 over the probes without it,
   // against 1.07 from 400 probes).
   tbb::parallel_for(size_t(0), kCandidates, [&](size_t j) {
-    std::vector<double> diff(pixels_);
+    std::vector<double> diff(grid_pixels_);
     double variance = 0;
-    for (size_t p = 0; p < pixels_; ++p) {
+    for (size_t p = 0; p < grid_pixels_; ++p) {
       const double v = relative_variance(p, j, means);
       diff[p] = std::numeric_limits<double>::infinity();
       if (!std::isfinite(v)) continue;
@@ -421,8 +457,8 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
   // and that every candidate shares, is mostly estimation noise; at full weight it drowns the
   // differences everywhere else and lets the cheapest candidate win. What a candidate has beyond
   // the least (its own fireflies: missing connections, fewer light paths) is kept in full.
-  std::vector<double> shared(pixels_);
-  for_pixel_blocks(pixels_, [&](size_t, size_t begin, size_t end) {
+  std::vector<double> shared(grid_pixels_);
+  for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p) {
       double least = std::numeric_limits<double>::infinity();
       for (size_t j = 0; j < kCandidates; ++j)
@@ -431,7 +467,7 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
     }
   });
   std::vector<double> sorted = shared;
-  const size_t q = std::min(pixels_ - 1, size_t(double(pixels_) * kWinsorize));
+  const size_t q = std::min(grid_pixels_ - 1, size_t(double(grid_pixels_) * kWinsorize));
   std::nth_element(sorted.begin(), sorted.begin() + q, sorted.end());
   const double cap = sorted[q];
   for (double& x : shared) x = std::isfinite(x) && x > cap ? cap - x : 0.0;
@@ -440,11 +476,11 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
 
 std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector<float>& means,
                                                      const std::vector<double>& correction) const {
-  std::vector<double> v(pixels_);
-  for_pixel_blocks(pixels_, [&](size_t, size_t begin, size_t end) {
+  std::vector<double> v(grid_pixels_);
+  for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p) v[p] = relative_variance(p, j, means) + correction[p];
   });
-  v = box_blur(v, width_, height_, kBlurRadius);
+  v = box_blur(v, grid_w_, grid_h_, kBlurRadius);
   for (double& x : v) x = std::max(x, 0.0);  // inf stays inf
   return v;
 }
@@ -452,7 +488,7 @@ std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector
 void AdaptivePlan::choose(const std::vector<float>& means) {
   const std::vector<Candidate>& list = candidates();
   const size_t k = list.size();
-  const double probes = double(probes_), pixels = double(pixels_);
+  const double probes = double(probes_), pixels = double(grid_pixels_);
   const PixelWork pw{work_.camera_vertices / (probes * pixels),
                      work_.connections / (probes * pixels * kProbeConnections),
                      work_.light_paths > 0 ? work_.light_vertices / work_.light_paths : 0.0,
@@ -473,8 +509,8 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   };
   Score best, path_tracing;
   size_t best_j = 0;
-  std::vector<PixelMode> modes(pixels_), best_modes(pixels_, PixelMode::PathTrace);
-  std::vector<double> variances(pixels_), best_variances(pixels_), pt_variances;
+  std::vector<PixelMode> modes(grid_pixels_), best_modes(grid_pixels_, PixelMode::PathTrace);
+  std::vector<double> variances(grid_pixels_), best_variances(grid_pixels_), pt_variances;
   nlohmann::json table = nlohmann::json::array();
   // Candidates come in (no merge, merge) pairs after path tracing at index 0.
   for (size_t j = 0; j < k; j += (j == 0 ? 1 : 2)) {
@@ -489,8 +525,8 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     // not make every pixel pay for the bidirectional core), the core, or the core and merging.
     // Per block of pixels: finite variance, cost, variance without and with merging
     // everywhere, pixels of infinite variance.
-    std::vector<std::array<double, 5>> blocks((pixels_ + kPixelBlock - 1) / kPixelBlock);
-    for_pixel_blocks(pixels_, [&](size_t b, size_t begin, size_t end) {
+    std::vector<std::array<double, 5>> blocks((grid_pixels_ + kPixelBlock - 1) / kPixelBlock);
+    for_pixel_blocks(grid_pixels_, [&](size_t b, size_t begin, size_t end) {
       std::array<double, 5> sum{};
       for (size_t p = begin; p < end; ++p) {
         const double v0 = no_merge[p], v1 = merge[p], vt = pt[p];
@@ -559,10 +595,18 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   chosen_variance_ = std::move(best_variances);
   const Candidate& c = list[best_j];
   chosen_ = {};
-  chosen_.light_paths = uint64_t(std::llround(double(c.light_path_factor) * pixels));
+  chosen_.light_paths = uint64_t(std::llround(double(c.light_path_factor) * double(pixels_)));
   chosen_.connections = c.connections;
   chosen_.merge_everywhere = false;
-  modes_ = best_modes;
+  // Each image pixel takes the mode of its block's probed pixel (the last row and column of
+  // grid pixels also cover what is left of the image beyond them).
+  for (int y = 0; y < height_; ++y) {
+    const size_t gy = std::min(size_t(y) / stride_, size_t(grid_h_ - 1));
+    for (int x = 0; x < width_; ++x) {
+      const size_t gx = std::min(size_t(x) / stride_, size_t(grid_w_ - 1));
+      modes_[size_t(y) * width_ + x] = best_modes[gy * grid_w_ + gx];
+    }
+  }
   history_.push_back({{"after_probe", probes_},
                       {"light_path_factor", c.light_path_factor},
                       {"connections", c.connections},

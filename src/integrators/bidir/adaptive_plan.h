@@ -27,18 +27,20 @@
 // and among those has the lowest total.
 //
 // Probes are iterations 0, 1, 3, 7, 15, 31, ... (2^k - 1): their cost fades as the render
-// grows. The first choice is made after the second probe; the variance all candidates share
-// is winsorised at its 99.5th percentile over the pixels (a shared firefly must not decide) and
-// pooled over 7 x 7 neighbours before the per-pixel decision (a handful of samples per pixel
-// would otherwise decide by luck; an infinite variance makes its whole window infinite).
-// Iterations and pixels that path trace (and are not probes) are rendered by pt's own estimator
-// (path_tracer.h, power heuristic unless --mis says otherwise), cheaper than the core's camera
-// subpaths, and no light-tracing splat lands in such a pixel; the cost model prices their camera
-// vertices separately.
-// Every iteration, probe or not, is an unbiased (consistent, when merging) estimate of the
-// same image, and the film averages them. Deterministic at fixed spp and seed for any thread
-// count unless measured costs are asked for, and for any number of MPI ranks: every rank renders
-// every probe, normalised by the film of all ranks (Integrator::shared_iteration).
+// grows. On an image of more than kProbePixels pixels a probe records one pixel per block of
+// the image and the estimates below are of that grid of pixels; the others render the last
+// choice (IterationPlan::records). The first choice is made after the second probe; the variance
+// all candidates share is winsorised at its 99.5th percentile over the pixels (a shared firefly
+// must not decide) and pooled over 7 x 7 neighbours before the per-pixel decision (a handful of
+// samples per pixel would otherwise decide by luck; an infinite variance makes its whole window
+// infinite). Iterations and pixels that path trace (and are not probes) are rendered by pt's own
+// estimator (path_tracer.h, power heuristic unless --mis says otherwise), cheaper than the core's
+// camera subpaths, and no light-tracing splat lands in such a pixel; the cost model prices their
+// camera vertices separately. Every iteration, probe or not, is an unbiased (consistent, when
+// merging) estimate of the same image, and the film averages them. Deterministic at fixed spp and
+// seed for any thread count unless measured costs are asked for, and for any number of MPI ranks:
+// every rank renders every probe, normalised by the film of all ranks
+// (Integrator::shared_iteration).
 #pragma once
 
 #include <algorithm>
@@ -63,16 +65,32 @@ struct IterationPlan {
   bool merge_everywhere = true;
   const std::vector<PixelMode>* modes = nullptr;  // per pixel, when !merge_everywhere
   bool probe = false;                             // record contributions for the planner
+  // A probe records every pixel (probe_stride 1) or, on a large image, the pixel at
+  // (probe_offset, probe_offset) of each probe_stride x probe_stride block of the image
+  // (width pixels wide): those render the probe's configuration (merging, probe_connections),
+  // every other pixel renders the last choice (modes, connections) with the probe's light paths.
+  uint32_t probe_stride = 1, probe_offset = 0, width = 0;
+  int probe_connections = 1;
+  bool records(size_t pixel) const {
+    if (!probe) return false;
+    if (probe_stride == 1) return true;
+    return (pixel % width) % probe_stride == probe_offset &&
+           (pixel / width) % probe_stride == probe_offset;
+  }
+  int connections_at(size_t pixel) const {
+    return records(pixel) ? probe_connections : connections;
+  }
   bool merges(size_t pixel) const {
-    return light_paths > 0 && (merge_everywhere || (modes && (*modes)[pixel] == PixelMode::Merge));
+    return light_paths > 0 &&
+           (merge_everywhere || records(pixel) || (modes && (*modes)[pixel] == PixelMode::Merge));
   }
   bool path_traces(size_t pixel) const {
-    return !probe && (light_paths == 0 ||
-                      (!merge_everywhere && modes && (*modes)[pixel] == PixelMode::PathTrace));
+    return !records(pixel) && (light_paths == 0 || (!merge_everywhere && modes &&
+                                                    (*modes)[pixel] == PixelMode::PathTrace));
   }
   bool any_merge() const {
     return light_paths > 0 &&
-           (merge_everywhere ||
+           (merge_everywhere || probe ||
             (modes && std::find(modes->begin(), modes->end(), PixelMode::Merge) != modes->end()));
   }
 };
@@ -96,7 +114,19 @@ void add_counts(ProbeWork& total, const ProbeWork& w);
 class AdaptivePlan {
  public:
   AdaptivePlan() = default;
-  AdaptivePlan(int width, int height, bool measured_costs, bool probe_every_iteration = false);
+  // probe_stride: record one pixel in each probe_stride x probe_stride block in probes (0: the
+  // stride for the image's size, kProbePixels).
+  AdaptivePlan(int width, int height, bool measured_costs, bool probe_every_iteration = false,
+               int probe_stride = 0);
+  // A probe renders its configuration (two connections per camera vertex, merging) and records
+  // every contribution; both cost about twice what a chosen iteration costs, and on a large
+  // image a probe is long beside the render (door-ajar at 640 x 480, 20 s, before this bound: 4
+  // probes of 2.5 s took 48% of the time). So an image of more than kProbePixels pixels
+  // probes about kProbePixels of them, one per block of the largest stride s with
+  // s^2 kProbePixels <= pixels: the estimates pool over so many pixels that the choice does not
+  // need more, and the other pixels render the last choice.
+  static constexpr double kProbePixels = 40000;
+  int probe_stride() const { return int(stride_); }
 
   bool is_probe(uint32_t iteration) const;
   IterationPlan plan(uint32_t iteration) const;
@@ -181,8 +211,19 @@ class AdaptivePlan {
   void check_last_choice(const std::vector<double>& measured, double iterations,
                          const std::vector<float>& means);
 
-  size_t pixels_ = 0;
+  size_t pixels_ = 0;  // the image's
   int width_ = 0, height_ = 0;
+  // The probed pixels form a grid_w_ x grid_h_ image (grid_pixels_ pixels): every per-pixel
+  // estimate below is of that grid, and a choice's modes_ take each image pixel's mode from the
+  // grid pixel of its block.
+  uint32_t stride_ = 1, offset_ = 0;
+  int grid_w_ = 0, grid_h_ = 0;
+  size_t grid_pixels_ = 0;
+  size_t grid_index(size_t pixel) const {
+    return size_t(pixel / width_ / stride_) * grid_w_ + (pixel % width_) / stride_;
+  }
+  template <typename T>
+  std::vector<T> on_grid(const std::vector<T>& image) const;
   bool measured_ = false;
   bool probe_all_ = false;
   // pixels x candidates: the sum over probes of the second-moment estimates, as float24 (3 bytes

@@ -26,46 +26,55 @@ Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pc
   acc.pixel = sample.pixel;
   acc.filter_weight = sample.filter_weight;
   if (techniques_.enabled()) acc.techniques = &techniques_;
+  const bool records = it.plan.records(sample.pixel);
   acc.rules = path_traces                    ? &it.rules_camera_only
+              : records                      ? &it.rules_probe
               : it.plan.merges(sample.pixel) ? &it.rules
                                              : &it.rules_no_merge;
-  if (it.plan.probe) {
+  if (records) {
     acc.plan = &plan_;
     acc.candidate_sums = plan_.pixel_start(sample.pixel);
   }
   // The clock is read only where it is used (a clock read per pixel was 0.6% of vcm's profile).
-  const bool timed = it.plan.probe && settings_.bidir.measured_costs;
+  const bool timed = records && settings_.bidir.measured_costs;
   const auto start =
       timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
   camera_path(scene, it, sample, rng, acc, arena);
   *nonfinite += acc.nonfinite;
-  if (it.plan.probe) {
+  if (records) {
     plan_.pixel_end(sample.pixel, acc.candidate_sums);
     if (timed) acc.work.camera_seconds = seconds_since(start);
   }
-  add_work(acc.work);
+  add_work(acc.work, records);
   if (tech_.guided) camera_values_[sample.pixel] = acc.sum * acc.filter_weight;
   return acc.sum;
 }
 
-void BidirIntegrator::add_work(const ProbeWork& w) const {
-  ProbeWork& mine = pixel_work_.local();
-  add_counts(mine, w);  // a pixel's work has no light paths or light vertices
-  mine.camera_seconds += w.camera_seconds;
-  mine.connect_seconds += w.connect_seconds;
-  mine.merge_seconds += w.merge_seconds;
+void BidirIntegrator::add_work(const ProbeWork& w, bool recorded) const {
+  auto add = [&](ProbeWork& mine) {
+    add_counts(mine, w);  // a pixel's work has no light paths or light vertices
+    mine.camera_seconds += w.camera_seconds;
+    mine.connect_seconds += w.connect_seconds;
+    mine.merge_seconds += w.merge_seconds;
+  };
+  add(pixel_work_.local());
+  if (recorded) add(recorded_work_.local());
 }
 
 void BidirIntegrator::collect_work() {
   // The counts are integers held in doubles, exact in any order; the seconds (measured costs
   // only) are not reproducible anyway.
-  for (ProbeWork& w : pixel_work_) {
-    add_counts(probe_, w);
-    probe_.camera_seconds += w.camera_seconds;
-    probe_.connect_seconds += w.connect_seconds;
-    probe_.merge_seconds += w.merge_seconds;
-    w = {};
-  }
+  auto collect = [](tbb::enumerable_thread_specific<ProbeWork>& per_thread, ProbeWork& total) {
+    for (ProbeWork& w : per_thread) {
+      add_counts(total, w);
+      total.camera_seconds += w.camera_seconds;
+      total.connect_seconds += w.connect_seconds;
+      total.merge_seconds += w.merge_seconds;
+      w = {};
+    }
+  };
+  collect(pixel_work_, probe_);
+  collect(recorded_work_, probe_recorded_);
 }
 
 void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
@@ -249,7 +258,7 @@ void BidirIntegrator::connect_to_light_paths(const Scene& scene, const Iteration
                                              uint64_t light_path, Pcg32& rng, ScratchArena& arena,
                                              PixelAccumulator& acc) const {
   const uint64_t n = it.plan.light_paths;
-  const int c = it.plan.connections;
+  const int c = it.plan.connections_at(acc.pixel);
   if (n == 0 || c == 0 || rules.counts().connect == 0) return;
   const Rgb scaled = v.beta / float(c);
   for (int j = 0; j < c; ++j) {

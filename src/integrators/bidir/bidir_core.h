@@ -83,6 +83,8 @@ struct Iteration {
   // In pixels that path trace (adaptive-vcm, PixelMode::PathTrace) when pt's estimator is not
   // at hand (technique images): emitter hits and next event estimation only.
   MisRules rules_camera_only = rules;
+  // In the pixels a probe records (plan.records): its connections and merging.
+  MisRules rules_probe = rules;
   float merge_normalization = 0;      // 1 / (N pi r^2)
   LightPathAssignment light_path_of;  // pixel -> the light subpath it connects to
 };
@@ -242,9 +244,10 @@ class BidirIntegrator final : public CameraPathIntegrator {
   Rgb estimate(const Scene& scene, const CameraSample& sample, Pcg32& rng, ScratchArena& arena,
                uint64_t* nonfinite) const override;
 
-  // A pixel's work, into its thread's (pixel_work_: no lock per pixel); collect_work() adds
-  // them to this iteration's (probe_) after the camera pass.
-  void add_work(const ProbeWork& w) const;
+  // A pixel's work, into its thread's (pixel_work_: no lock per pixel; recorded: a pixel the
+  // probe records, also into recorded_work_); collect_work() adds them to this iteration's
+  // (probe_, and probe_recorded_ for the plan) after the camera pass.
+  void add_work(const ProbeWork& w, bool recorded) const;
   void collect_work();
 
   void camera_path(const Scene& scene, const Iteration& it, const CameraSample& sample, Pcg32& rng,
@@ -346,9 +349,10 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
   // adaptive-vcm: the plan, and the work of the current probe iteration.
   mutable AdaptivePlan plan_;
-  ProbeWork probe_;          // this iteration's work
-  uint64_t light_rays_ = 0;  // this iteration's light-subpath rays (append_chunk)
-  mutable tbb::enumerable_thread_specific<ProbeWork> pixel_work_;
+  ProbeWork probe_;           // this iteration's work
+  ProbeWork probe_recorded_;  // the camera-pass work of the pixels a probe records
+  uint64_t light_rays_ = 0;   // this iteration's light-subpath rays (append_chunk)
+  mutable tbb::enumerable_thread_specific<ProbeWork> pixel_work_, recorded_work_;
   // adaptive-vcm's path-tracing iterations (no light paths, not a probe) are rendered by pt's
   // own estimator: the same image in expectation, about 1.25x cheaper than the core's camera
   // subpaths, which carry MIS sums no technique reads. Probes stay in the core (they price

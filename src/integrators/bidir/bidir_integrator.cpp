@@ -90,7 +90,7 @@ void BidirIntegrator::prepare(const Scene& scene, Film& film) {
   }
   if (tech_.adaptive)
     plan_ = AdaptivePlan(film.width(), film.height(), settings_.bidir.measured_costs,
-                         settings_.bidir.probe_every_iteration);
+                         settings_.bidir.probe_every_iteration, settings_.bidir.probe_stride);
   if (tech_.adaptive && !techniques_.enabled())
     path_tracer_ = std::make_unique<PathTracer>(settings_);
   if (tech_.adaptive) segment_.reset(film.pixel_count());
@@ -123,11 +123,19 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   it.rules = MisRules(heuristic_, counts);
   it.rules_no_merge = it.rules.with_merging(false);
   it.rules_camera_only = MisRules(heuristic_, {counts.emitter, 0.f, 0.f, 0.f});
+  it.rules_probe = it.rules;
+  if (it.plan.probe && it.plan.probe_stride > 1) {
+    MisCounts probe = counts;
+    probe.connect = connect && n > 0 ? float(it.plan.probe_connections) : 0.f;
+    probe.merge = tech_.merge ? kPi * it.radius * it.radius * float(n) : 0.f;
+    it.rules_probe = MisRules(heuristic_, probe);
+  }
   it.merge_normalization = n ? 1.f / (kPi * it.radius * it.radius * float(n)) : 0.f;
   it.light_path_of =
       LightPathAssignment(film.pixel_count(), std::max<uint64_t>(n, 1), iteration, settings_.seed);
   if (tech_.guided) guiding_.begin_iteration(iteration, seconds_since(start_), n);
   probe_ = {};
+  probe_recorded_ = {};
   probe_.light_paths = double(n);
   if (it.plan.probe) plan_.begin_probe(it.radius);
   if (path_tracer_ && n == 0 && !it.plan.probe) ++path_tracing_iterations_;
@@ -177,10 +185,16 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   probe_.light_rays = double(light_rays_);
   add_counts(work_total_, probe_);
   if (it.plan.probe) {
-    probe_.light_seconds = light_chunk_seconds_;
-    if (probe_.light_seconds == 0) probe_.light_seconds = light_seconds;
-    if (probe_.camera_seconds == 0) probe_.camera_seconds = seconds_since(camera_start);
-    plan_.finish_probe(probe_, means_before, measured, measured_iterations);
+    // The plan prices the recorded pixels' camera-pass work and the whole light pass.
+    ProbeWork work = probe_recorded_;
+    work.light_paths = probe_.light_paths;
+    work.light_vertices = probe_.light_vertices;
+    work.light_rays = probe_.light_rays;
+    work.light_seconds = light_chunk_seconds_;
+    if (work.light_seconds == 0) work.light_seconds = light_seconds;
+    if (work.camera_seconds == 0 && it.plan.probe_stride == 1)
+      work.camera_seconds = seconds_since(camera_start);
+    plan_.finish_probe(work, means_before, measured, measured_iterations);
   } else if (tech_.adaptive) {
     segment_.end_iteration(film);
   }

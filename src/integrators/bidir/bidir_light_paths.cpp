@@ -124,8 +124,9 @@ void BidirIntegrator::append_chunk(const Iteration& it, const LightChunk& chunk)
     const Splat& s = chunk.splats[i];
     splat_image_[s.pixel] += s.value;
     if (techniques_.enabled()) techniques_.add(s.technique, s.pixel, s.value);
-    if (it.plan.probe)
-      plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[i], it.rules.counts());
+    if (it.plan.records(s.pixel))
+      plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[i],
+                            it.rules_probe.counts());
   }
 }
 
@@ -236,22 +237,28 @@ bool BidirIntegrator::splat_lens_connection(const Camera& camera, const Iteratio
                                             uint32_t technique, const ValueOf& value_of,
                                             const TermsOf& terms_of, LightChunk& chunk) const {
   const size_t first_splat = chunk.splats.size();
-  filter_.for_each_pixel(
-      raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
-        const uint32_t pixel = uint32_t(y * camera.width() + x);
-        if (tech_.adaptive && it.plan.path_traces(pixel)) return;  // pt's estimator alone there
-        const MisRules& rules = it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
-        const TechniqueTerms terms = terms_of(rules, fs.pdf);
-        const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
-        const Rgb value = value_of(w) * (fs.weight * fs.pdf);
-        if (value.is_black()) return;
-        if (!value.is_finite()) {
-          ++chunk.nonfinite;
-          return;
-        }
-        chunk.splats.push_back({pixel, technique, value});
-        if (it.plan.probe) chunk.splat_terms.push_back(terms);
-      });
+  // A pixel a probe records weights by the probe's counts, the others by the choice's.
+  auto rules_at = [&](uint32_t pixel) -> const MisRules& {
+    if (it.plan.records(pixel)) return it.rules_probe;
+    return it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
+  };
+  filter_.for_each_pixel(raster, camera.width(), camera.height(),
+                         [&](int x, int y, const FilterSample& fs) {
+                           const uint32_t pixel = uint32_t(y * camera.width() + x);
+                           if (tech_.adaptive && it.plan.path_traces(pixel))
+                             return;  // pt's estimator alone there
+                           const MisRules& rules = rules_at(pixel);
+                           const TechniqueTerms terms = terms_of(rules, fs.pdf);
+                           const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
+                           const Rgb value = value_of(w) * (fs.weight * fs.pdf);
+                           if (value.is_black()) return;
+                           if (!value.is_finite()) {
+                             ++chunk.nonfinite;
+                             return;
+                           }
+                           chunk.splats.push_back({pixel, technique, value});
+                           if (it.plan.probe) chunk.splat_terms.push_back(terms);
+                         });
   return chunk.splats.size() > first_splat;
 }
 

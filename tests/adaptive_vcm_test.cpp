@@ -475,6 +475,7 @@ TEST(AdaptiveVcm, ProbesOfLargeImagesRecordOnePixelPerBlock) {
   EXPECT_EQ(differing, 0u);
   // The choice was made on the 10 x 8 grid and covers every pixel.
   const nlohmann::json stats = adaptive_stats(*scene, s, 16);
+  EXPECT_EQ(stats["adaptive"]["probe_stride"].get<int>(), 3);
   const auto& mask = stats["adaptive"]["merge_mask"];
   EXPECT_EQ(mask["width"].get<int>() * mask["block"].get<int>(), 30);
 }

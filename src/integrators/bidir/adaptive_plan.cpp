@@ -11,6 +11,7 @@
 
 #include "core/compact_float.h"
 #include "core/math.h"
+#include "integrators/bidir/grid_statistics.h"
 
 namespace caustica::bidir {
 
@@ -42,7 +43,6 @@ constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
 constexpr int kBlurRadius = 3;        // pixel variances pooled over 7 x 7 (box_blur)
 constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
 constexpr int kFirstProbes = 2;
-constexpr size_t kPixelBlock = 4096;  // the choice's parallel blocks (for_pixel_blocks)
 // Path tracing is kept unless another configuration's predicted relVar x time is lower by more
 // than this factor. The cost model has no term for the per-iteration costs of light paths (their
 // pipeline, the splats), and the predicted variances carry a few percent of noise: on mis-plates
@@ -58,18 +58,6 @@ constexpr double kPathTracingMargin = 1.05;
 // 0.000586 / 0.000420, 0.000362 / 0.000320; material-spheres 0.000257 / 0.000278, 0.000264 /
 // 0.000276, 0.000253 / 0.000257.
 constexpr double kPathTracingPixelMargin = 1.1;
-// The q-quantile of the finite values (0 if none).
-double finite_quantile(const std::vector<double>& values, double q) {
-  std::vector<double> finite;
-  finite.reserve(values.size());
-  for (double v : values)
-    if (std::isfinite(v)) finite.push_back(v);
-  if (finite.empty()) return 0.0;
-  const size_t at = std::min(finite.size() - 1, size_t(double(finite.size()) * q));
-  std::nth_element(finite.begin(), finite.begin() + at, finite.end());
-  return finite[at];
-}
-
 // The operation costs: the model, or what the probes measured (seconds summed over threads).
 CostModel costs_of(const ProbeWork& w, bool measured) {
   CostModel t;
@@ -92,48 +80,6 @@ CostModel costs_of(const ProbeWork& w, bool measured) {
     t.photon *= scale;
   }
   return t;
-}
-
-// Separable box filter of the given radius (clamped at the borders): a pixel's variance estimate
-// rests on a handful of probe samples; choosing per pixel between two such estimates picks the
-// luckier one (a caustic pixel whose probes missed the caustic stops merging). Neighbours share
-// their light transport, so their estimates are pooled.
-// An infinite variance (a path the candidate cannot make) makes every pixel whose window holds
-// it infinite; it is counted, not summed: inf - inf in the running sum made the rest of the row
-// NaN, and a NaN in every candidate's sum left the choice to its default, path tracing, which
-// cannot make the path either (sun-glass: the sun's caustic seen through the glass ball).
-std::vector<double> box_blur(const std::vector<double>& in, int w, int h, int r) {
-  std::vector<double> tmp(in.size()), out(in.size());
-  auto pass = [r](const double* src, double* dst, int n, int stride) {
-    double sum = 0;
-    int count = 0, infinite = 0;
-    auto enter = [&](double v, int sign) {
-      if (std::isfinite(v))
-        sum += sign * v;
-      else
-        infinite += sign;  // NaN counts as infinite
-      count += sign;
-    };
-    for (int i = 0; i < std::min(r, n); ++i) enter(src[size_t(i) * stride], 1);
-    for (int i = 0; i < n; ++i) {
-      if (i + r < n) enter(src[size_t(i + r) * stride], 1);
-      if (i - r - 1 >= 0) enter(src[size_t(i - r - 1) * stride], -1);
-      dst[size_t(i) * stride] =
-          infinite > 0 ? std::numeric_limits<double>::infinity() : sum / count;
-    }
-  };
-  // Rows, then columns, each independent of the others: in parallel, the same sums.
-  tbb::parallel_for(0, h, [&](int y) { pass(&in[size_t(y) * w], &tmp[size_t(y) * w], w, 1); });
-  tbb::parallel_for(0, w, [&](int x) { pass(&tmp[x], &out[x], h, w); });
-  return out;
-}
-
-// fn(block, begin, end) over [0, n) in blocks of a fixed size, in parallel: per-block partial sums
-// added in block order afterwards are the same for any thread count.
-template <typename Fn>
-void for_pixel_blocks(size_t n, Fn&& fn) {
-  tbb::parallel_for(size_t(0), (n + kPixelBlock - 1) / kPixelBlock,
-                    [&](size_t b) { fn(b, b * kPixelBlock, std::min(n, (b + 1) * kPixelBlock)); });
 }
 
 // Per pixel and iteration, from the probes' work (light paths at one per pixel).

@@ -9,6 +9,9 @@ namespace caustica::bidir {
 void AdaptivePlan::report(nlohmann::json& stats) const {
   nlohmann::json a;
   a["probes"] = probes_;
+  // A probe records one pixel per probe_stride x probe_stride block (1: every pixel); the
+  // candidates' variances and pixel counts are of those pixels.
+  a["probe_stride"] = stride_;
   a["costs"] = measured_ ? "measured" : "model";
   a["light_paths_per_iteration"] = chosen_.light_paths;
   a["connections"] = chosen_.connections;

@@ -27,10 +27,7 @@ Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pc
   acc.filter_weight = sample.filter_weight;
   if (techniques_.enabled()) acc.techniques = &techniques_;
   const bool records = it.plan.records(sample.pixel);
-  acc.rules = path_traces                    ? &it.rules_camera_only
-              : records                      ? &it.rules_probe
-              : it.plan.merges(sample.pixel) ? &it.rules
-                                             : &it.rules_no_merge;
+  acc.rules = path_traces ? &it.rules_camera_only : &it.rules_at(sample.pixel);
   if (records) {
     acc.plan = &plan_;
     acc.candidate_sums = plan_.pixel_start(sample.pixel);

@@ -87,6 +87,13 @@ struct Iteration {
   MisRules rules_probe = rules;
   float merge_normalization = 0;      // 1 / (N pi r^2)
   LightPathAssignment light_path_of;  // pixel -> the light subpath it connects to
+  // The rules every technique of a pixel that runs the core weights by (its camera subpaths
+  // and the light-tracing splats landing in it): a probe's if the probe records the pixel,
+  // else the choice's with or without merging. One function for both, so that they agree.
+  const MisRules& rules_at(size_t pixel) const {
+    if (plan.records(pixel)) return rules_probe;
+    return plan.merges(pixel) ? rules : rules_no_merge;
+  }
 };
 
 // A light vertex rebuilt for connections: its interaction and BSDF (from the stored vertex) and

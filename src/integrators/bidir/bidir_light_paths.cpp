@@ -237,17 +237,12 @@ bool BidirIntegrator::splat_lens_connection(const Camera& camera, const Iteratio
                                             uint32_t technique, const ValueOf& value_of,
                                             const TermsOf& terms_of, LightChunk& chunk) const {
   const size_t first_splat = chunk.splats.size();
-  // A pixel a probe records weights by the probe's counts, the others by the choice's.
-  auto rules_at = [&](uint32_t pixel) -> const MisRules& {
-    if (it.plan.records(pixel)) return it.rules_probe;
-    return it.plan.merges(pixel) ? it.rules : it.rules_no_merge;
-  };
   filter_.for_each_pixel(raster, camera.width(), camera.height(),
                          [&](int x, int y, const FilterSample& fs) {
                            const uint32_t pixel = uint32_t(y * camera.width() + x);
                            if (tech_.adaptive && it.plan.path_traces(pixel))
                              return;  // pt's estimator alone there
-                           const MisRules& rules = rules_at(pixel);
+                           const MisRules& rules = it.rules_at(pixel);
                            const TechniqueTerms terms = terms_of(rules, fs.pdf);
                            const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
                            const Rgb value = value_of(w) * (fs.weight * fs.pdf);

@@ -3,6 +3,7 @@
 // what it chooses is reported and reproducible.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <initializer_list>
@@ -478,6 +479,34 @@ TEST(AdaptiveVcm, ProbesOfLargeImagesRecordOnePixelPerBlock) {
   EXPECT_EQ(stats["adaptive"]["probe_stride"].get<int>(), 3);
   const auto& mask = stats["adaptive"]["merge_mask"];
   EXPECT_EQ(mask["width"].get<int>() * mask["block"].get<int>(), 30);
+}
+
+// After the first choice a sparse probe traces the chosen light paths (at least half a path and
+// at most one per pixel), not always one per pixel: its other pixels render the choice as it is.
+// Every iteration a probe of one pixel per 3 x 3 block; the choice after probe k is what iteration
+// k traces.
+TEST(AdaptiveVcm, SparseProbesTraceTheChosenLightPaths) {
+  auto scene = make_builtin_scene("cornell-glass", 30, 24);
+  IntegratorSettings s;
+  s.max_depth = 6;
+  s.seed = 3;
+  s.bidir.probe_stride = 3;
+  s.bidir.probe_every_iteration = true;
+  constexpr int kIterations = 16;
+  constexpr double kPixels = 720;
+  const nlohmann::json stats = adaptive_stats(*scene, s, kIterations);
+  double expected = 2 * kPixels;  // probes 0 and 1, before any choice
+  int fewer = 0;                  // probes after a choice of fewer light paths than pixels
+  for (const auto& h : stats["adaptive"]["history"]) {
+    const int after = h["after_probe"].get<int>();
+    if (after >= kIterations) continue;  // a choice no iteration rendered
+    const double chosen = std::llround(h["light_path_factor"].get<double>() * kPixels);
+    expected += std::clamp(chosen, kPixels / 2, kPixels);
+    fewer += chosen < kPixels;
+  }
+  EXPECT_GT(fewer, 0);  // else this test could not tell the probes' light paths from one each
+  EXPECT_DOUBLE_EQ(stats["bidir"]["work_per_iteration"]["light_paths"].get<double>(),
+                   expected / kIterations);
 }
 
 // Sparse probes keep the image unbiased: every pixel, probed or not, weights its techniques by

@@ -193,11 +193,16 @@ IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
     return p;
   }
   if (is_probe(iteration)) {
-    // The probed pixels need the probe's light paths; the others render the last choice
-    // with them.
+    // The other pixels render the last choice, with its light paths as far as the probe's
+    // range allows: the probed pixels price every candidate from them (the proxy holds for any
+    // probe counts) and need some, at least kSparseProbeLightPaths per pixel where path tracing
+    // was chosen; and more than one per pixel made the probe dearer for no better choice
+    // (door-ajar, which chooses two).
     IterationPlan p = chosen_;
     p.modes = &modes_;
-    p.light_paths = pixels_;
+    p.light_paths = std::clamp(chosen_.light_paths,
+                               uint64_t(std::llround(kSparseProbeLightPaths * double(pixels_))),
+                               uint64_t(pixels_));
     p.probe = true;
     p.probe_stride = stride_;
     p.probe_offset = offset_;
@@ -317,7 +322,11 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   // The light-tracing sums (6 bytes per pixel and candidate) are only needed while a probe
   // renders; released before the choice, so that its buffers do not add to them.
   std::vector<uint16_t>().swap(light_sums_);
-  add_counts(work_, w);
+  // The cost model's photons are those of one light path per pixel (merge_cost scales them
+  // with a candidate's factor); a sparse probe traces the chosen light paths.
+  ProbeWork normalized = w;
+  if (w.light_paths > 0) normalized.photons *= double(pixels_) / w.light_paths;
+  add_counts(work_, normalized);
   work_.light_seconds += w.light_seconds;
   work_.camera_seconds += w.camera_seconds;
   work_.connect_seconds += w.connect_seconds;

@@ -29,7 +29,8 @@
 // Probes are iterations 0, 1, 3, 7, 15, 31, ... (2^k - 1): their cost fades as the render
 // grows. On an image of more than kProbePixels pixels a probe records one pixel per block of
 // the image and the estimates below are of that grid of pixels; the others render the last
-// choice (IterationPlan::records). The first choice is made after the second probe; the variance
+// choice (IterationPlan::records), with its light paths (kSparseProbeLightPaths to one per
+// pixel) once there is one. The first choice is made after the second probe; the variance
 // all candidates share is winsorised at its 99.5th percentile over the pixels (a shared firefly
 // must not decide) and pooled over 7 x 7 neighbours before the per-pixel decision (a handful of
 // samples per pixel would otherwise decide by luck; an infinite variance makes its whole window
@@ -68,7 +69,7 @@ struct IterationPlan {
   // A probe records every pixel (probe_stride 1) or, on a large image, the pixel at
   // (probe_offset, probe_offset) of each probe_stride x probe_stride block of the image
   // (width pixels wide): those render the probe's configuration (merging, probe_connections),
-  // every other pixel renders the last choice (modes, connections) with the probe's light paths.
+  // every other pixel renders the last choice (modes, connections), all with light_paths.
   uint32_t probe_stride = 1, probe_offset = 0, width = 0;
   int probe_connections = 1;
   bool records(size_t pixel) const {
@@ -126,6 +127,10 @@ class AdaptivePlan {
   // s^2 kProbePixels <= pixels: the estimates pool over so many pixels that the choice does not
   // need more, and the other pixels render the last choice.
   static constexpr double kProbePixels = 40000;
+  // After the first choice a sparse probe traces the chosen light paths (the probe's light
+  // pass had cost up to 3x the chosen one: mirror-caustic at 640 x 480 chose half a light path
+  // per pixel), at least this many and at most one per pixel.
+  static constexpr double kSparseProbeLightPaths = 0.5;
   int probe_stride() const { return int(stride_); }
 
   bool is_probe(uint32_t iteration) const;

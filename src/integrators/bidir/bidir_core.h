@@ -67,7 +67,8 @@ struct LightChunk {
   std::vector<LightVertex> vertices;
   std::vector<uint32_t> path_ends;  // per path: vertices.size() after it
   std::vector<Splat> splats;
-  std::vector<TechniqueTerms> splat_terms;  // probe iterations: each splat's MIS terms
+  // Probes: the MIS terms of the splats that land in recorded pixels, in splat order.
+  std::vector<TechniqueTerms> splat_terms;
   uint64_t nonfinite = 0;
   uint64_t rays = 0;   // rays traced (every bounce, delta ones too)
   double seconds = 0;  // probe iterations: time spent tracing the chunk

@@ -120,12 +120,12 @@ void BidirIntegrator::append_chunk(const Iteration& it, const LightChunk& chunk)
     path_begin_[chunk.first_path + i] = base + (i ? chunk.path_ends[i - 1] : 0);
   light_chunk_seconds_ += chunk.seconds;
   light_rays_ += chunk.rays;
-  for (size_t i = 0; i < chunk.splats.size(); ++i) {
-    const Splat& s = chunk.splats[i];
+  size_t recorded = 0;  // the splats in recorded pixels, whose terms the chunk kept
+  for (const Splat& s : chunk.splats) {
     splat_image_[s.pixel] += s.value;
     if (techniques_.enabled()) techniques_.add(s.technique, s.pixel, s.value);
     if (it.plan.records(s.pixel))
-      plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[i],
+      plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[recorded++],
                             it.rules_probe.counts());
   }
 }
@@ -252,7 +252,8 @@ bool BidirIntegrator::splat_lens_connection(const Camera& camera, const Iteratio
                              return;
                            }
                            chunk.splats.push_back({pixel, technique, value});
-                           if (it.plan.probe) chunk.splat_terms.push_back(terms);
+                           // The plan prices the recorded pixels' splats (append_chunk).
+                           if (it.plan.records(pixel)) chunk.splat_terms.push_back(terms);
                          });
   return chunk.splats.size() > first_splat;
 }

@@ -361,6 +361,7 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
                      c.algorithm != BidirAlgorithm::GuidedBpt && c.pixel_merges;
   int checked = 0, attempts = 0, with_delta = 0, seen_directly = 0;
   double worst_sum = 0, worst_oracle = 0;
+  int stop_compared = 0;  // techniques whose photon-mapping density was compared
   ExplicitPath path;
   while (checked < paths && attempts < 50 * paths) {
     ++attempts;
@@ -388,6 +389,28 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
     }
     ASSERT_EQ(weights.size(), oracle.size()) << c.scene;
     worst_sum = std::max(worst_sum, std::abs(sum - 1));
+    // adaptive-vcm's per-pixel photon mapping (PixelMode::Stop): exactly one technique makes
+    // the path there, and every technique's terms give the same density of it relative to
+    // theirs (the proxy correction of its variance; checked where a technique's weight is not
+    // negligible, so its terms are not dominated by rounding).
+    if (connect && merge) {
+      double stop_sum = 0, reference = 0, heaviest = 0;
+      for (const auto& w : weights) {
+        stop_sum += w.stop_weight;
+        if (w.weight > heaviest) {
+          heaviest = w.weight;
+          reference = w.stop_ratio;
+        }
+      }
+      ASSERT_NEAR(stop_sum, 1.0, 1e-6) << c.scene << " path " << checked;
+      for (const auto& w : weights) {
+        if (!(w.weight > 1e-3)) continue;
+        EXPECT_NEAR(w.stop_ratio, reference, 2e-3 * reference + 1e-12)
+            << c.scene << " merge " << w.merge << " s " << w.s << " t " << w.t << " path "
+            << checked;
+        stop_compared += &w != &weights.front() || weights.size() > 1;
+      }
+    }
     seen_directly += path.surfaces.empty();
     for (const SurfaceInteraction& si : path.surfaces)
       if (si.material->bsdf(si, arena).is_delta()) {
@@ -413,6 +436,7 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
     ++checked;
   }
   EXPECT_EQ(checked, paths) << c.scene << ": could not build enough paths";
+  if (connect && merge) EXPECT_GT(stop_compared, paths) << c.scene;
   // Area lights seen straight from the lens (s = 0 against s = 1, t = 1) are among the paths.
   bool area_lights = false;
   for (const Light* l : scene.lights()) area_lights |= l->type() == LightType::Area;

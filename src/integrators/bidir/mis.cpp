@@ -45,6 +45,16 @@ float TechniqueTerms::denominator(const MisCounts& counts) const {
   return counts.of(own) * own_factor + others(*this, counts);
 }
 
+float TechniqueTerms::stop_own(float n_emitter, float n_merge) const {
+  if (delta_chain) return own == TechniqueClass::Emitter ? n_emitter : 0.f;
+  return own_first_merge ? n_merge : 0.f;
+}
+
+float TechniqueTerms::stop_denominator(float n_emitter, float n_merge) const {
+  if (delta_chain) return own == TechniqueClass::Emitter ? n_emitter : times(n_emitter, emitter);
+  return own_first_merge ? n_merge : times(n_merge, first_merge);
+}
+
 MisRules::MisRules(MisHeuristic heuristic, const MisCounts& counts)
     : power_(heuristic == MisHeuristic::Power) {
   counts_ = {mis(counts.emitter), mis(counts.light_trace), mis(counts.connect), mis(counts.merge)};
@@ -72,7 +82,9 @@ MisRules MisRules::with_merging(bool merge) const {
 
 MisSums MisRules::camera_start(float camera_pdf_w) const {
   // dVCM = 1 / p(camera ray): the light-tracing technique (its count enters at the weights).
-  return {mis(1.f / camera_pdf_w), 0.f, 0.f, 0.f, true};
+  MisSums s;
+  s.vcm = mis(1.f / camera_pdf_w);
+  return s;
 }
 
 MisSums MisRules::light_first_hit(float direct_pdf, float emission_pdf, float cos_at_light,
@@ -97,6 +109,7 @@ void MisRules::hit(MisSums& s, float dist2, float cos_at_hit) const {
   s.rest = times(s.rest, inv_cos);
   s.conn = times(s.conn, inv_cos);
   s.merge = times(s.merge, inv_cos);
+  s.first_merge = times(s.first_merge, inv_cos);
 }
 
 void MisRules::scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev,
@@ -111,6 +124,7 @@ void MisRules::scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev,
     s.rest = times(s.rest, c);
     s.conn = times(s.conn, c);
     s.merge = times(s.merge, c);
+    s.first_merge = times(s.first_merge, c);
     return;
   }
   // eqs. 34-36 (the 1/dist^2 and 1/cos of the next vertex follow in hit()). The vertex's own
@@ -122,6 +136,8 @@ void MisRules::scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev,
   s.rest = times(g, times(s.rest, rev) + (first ? s.vcm : 0.f));
   s.conn = times(g, times(s.conn, rev) + (first ? 0.f : s.vcm));
   s.merge = times(g, times(s.merge, rev) + 1.f);
+  s.first_merge = s.past_delta_chain ? times(g, times(s.first_merge, rev)) : g;
+  s.past_delta_chain = true;
   s.vcm = mis(1.f / pdf_fwd);
 }
 
@@ -139,6 +155,12 @@ void MisRules::add_beyond(TechniqueTerms& t, const MisSums& s, TechniqueClass re
   t.merge += times(r, s.merge);
 }
 
+void MisRules::add_first_merge(TechniqueTerms& t, const MisSums& camera, float scale,
+                               float pdf_rev) const {
+  t.first_merge =
+      camera.past_delta_chain ? times(times(scale, mis(pdf_rev)), camera.first_merge) : scale;
+}
+
 TechniqueTerms MisRules::hit_light(const MisSums& camera, float direct_pdf, float emission_pdf,
                                    float nee_probability) const {
   // eqs. 42-43: the light subpath is empty; the camera side holds NEE and everything further.
@@ -150,6 +172,8 @@ TechniqueTerms MisRules::hit_light(const MisSums& camera, float direct_pdf, floa
   t.light_trace = times(e, camera.rest);
   t.connect = times(e, camera.conn);
   t.merge = times(e, camera.merge);
+  t.first_merge = times(e, camera.first_merge);
+  t.delta_chain = !camera.past_delta_chain;
   return t;
 }
 
@@ -158,6 +182,7 @@ TechniqueTerms MisRules::hit_light_from_lens(const MisSums& camera, float emissi
   TechniqueTerms t;
   t.own = TechniqueClass::Emitter;
   t.light_trace = times(mis(emission_pos_pdf), camera.vcm);
+  t.delta_chain = true;
   return t;
 }
 
@@ -165,6 +190,7 @@ TechniqueTerms MisRules::light_origin_to_camera(float camera_pdf_a, float emissi
   TechniqueTerms t;
   t.own = TechniqueClass::LightTrace;
   t.emitter = mis(camera_pdf_a / emission_pos_pdf);
+  t.delta_chain = true;
   return t;
 }
 
@@ -176,9 +202,9 @@ TechniqueTerms MisRules::next_event(const MisSums& camera, float bsdf_pdf_fwd, f
   // eq. 44: BSDF sampling hitting the light instead (both solid angle at the camera vertex).
   t.emitter = mis(bsdf_pdf_fwd / direct_pdf_w);
   // eq. 45: emission_pdf_a / direct_pdf_a at the camera vertex; the dist^2 of both cancel.
-  add_beyond(t, camera, TechniqueClass::LightTrace,
-             mis(emission_pdf_w * cos_to_light / (direct_pdf_w * cos_at_light)), bsdf_pdf_rev,
-             true);
+  const float scale = mis(emission_pdf_w * cos_to_light / (direct_pdf_w * cos_at_light));
+  add_beyond(t, camera, TechniqueClass::LightTrace, scale, bsdf_pdf_rev, true);
+  add_first_merge(t, camera, scale, bsdf_pdf_rev);
   return t;
 }
 
@@ -189,6 +215,7 @@ TechniqueTerms MisRules::connect(const MisSums& light, const MisSums& camera, fl
   add_beyond(t, light, TechniqueClass::Emitter, mis(camera_pdf_a), light_rev_w, true);  // eq. 40
   add_beyond(t, camera, TechniqueClass::LightTrace, mis(light_pdf_a), camera_rev_w,
              true);  // eq. 41
+  add_first_merge(t, camera, mis(light_pdf_a), camera_rev_w);
   return t;
 }
 
@@ -197,6 +224,8 @@ TechniqueTerms MisRules::light_to_camera(const MisSums& light, float camera_pdf_
   TechniqueTerms t;
   t.own = TechniqueClass::LightTrace;
   add_beyond(t, light, TechniqueClass::Emitter, mis(camera_pdf_a), light_rev_w, true);  // eq. 46
+  // The light vertex is the first the camera side of the path has: merging there.
+  t.first_merge = mis(camera_pdf_a);
   return t;
 }
 
@@ -206,6 +235,8 @@ TechniqueTerms MisRules::merge(const MisSums& light, const MisSums& camera, floa
   t.own = TechniqueClass::Merge;
   add_beyond(t, light, TechniqueClass::Emitter, 1.f, camera_pdf_fwd_w, false);      // eq. 38
   add_beyond(t, camera, TechniqueClass::LightTrace, 1.f, camera_pdf_rev_w, false);  // eq. 39
+  t.own_first_merge = !camera.past_delta_chain;
+  if (camera.past_delta_chain) add_first_merge(t, camera, 1.f, camera_pdf_rev_w);
   return t;
 }
 

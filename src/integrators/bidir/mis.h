@@ -62,6 +62,11 @@ struct MisSums {
   float conn = 0;     // connections behind (s', t' >= 2)
   float merge = 0;    // merges behind
   bool first = true;  // the vertex is its subpath's first: vcm belongs to the "rest" class
+  // Camera subpaths only (adaptive-vcm's per-pixel photon mapping, PixelMode::Stop): the one
+  // term of `merge` that stands for merging at the subpath's first vertex scattered through a
+  // non-delta lobe, once there is one (past_delta_chain).
+  float first_merge = 0;
+  bool past_delta_chain = false;
 };
 
 // The other techniques of one path relative to the current one, sum_k p_k / p_current by class
@@ -69,6 +74,18 @@ struct MisSums {
 struct TechniqueTerms {
   TechniqueClass own = TechniqueClass::Connect;
   float emitter = 0, light_trace = 0, connect = 0, merge = 0;
+  // The photon-mapping estimator of a pixel (camera subpaths that end at their first vertex
+  // scattered through a non-delta lobe, PixelMode::Stop) makes a path in one way only: by
+  // merging at that vertex, or, if the camera side of the path has none (delta_chain), by the
+  // camera subpath hitting the emitter (s = 0). first_merge: that merge's term (mis()'d), or
+  // own_first_merge if it is the current technique.
+  float first_merge = 0;
+  bool own_first_merge = false;
+  bool delta_chain = false;
+  // Under that estimator with an emitter count n_emitter and a merge count n_merge (mis()'d):
+  // the current technique's own count (0 if it is not the one way) and the denominator.
+  float stop_own(float n_emitter, float n_merge) const;
+  float stop_denominator(float n_emitter, float n_merge) const;
   // The current technique's own count is its class's times this factor (through mis()): the
   // learned probability with which its vertex takes it (guided-bpt, guided-vcm; see
   // MisRules::scale_vcm). The contribution then divides by that probability.
@@ -165,6 +182,9 @@ class MisRules {
   // times mis(pdf_rev)). rest_class: Emitter on the light subpath, LightTrace on the camera's.
   void add_beyond(TechniqueTerms& t, const MisSums& s, TechniqueClass rest_class, float scale,
                   float pdf_rev, bool with_merge_here) const;
+  // Sets t's first_merge (or delta_chain) from the camera sums at a camera vertex that a
+  // technique with this scale completes (as add_beyond on the camera side, with merging there).
+  void add_first_merge(TechniqueTerms& t, const MisSums& camera, float scale, float pdf_rev) const;
 
   bool power_;
   MisCounts counts_;  // through mis()

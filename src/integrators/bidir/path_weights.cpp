@@ -9,6 +9,21 @@
 
 namespace caustica::bidir {
 
+namespace {
+TechniqueWeight weight_of(const MisRules& rules, bool merge, int s, int t,
+                          const TechniqueTerms& terms) {
+  const MisCounts& n = rules.counts();
+  const float stop = terms.stop_denominator(n.emitter, n.merge);
+  const float w = terms.weight(n), own = n.of(terms.own) * terms.own_factor;
+  return {merge,
+          s,
+          t,
+          w,
+          stop > 0 ? terms.stop_own(n.emitter, n.merge) / stop : 0.f,
+          own > 0 ? w * stop / own : 0.f};
+}
+}  // namespace
+
 std::vector<TechniqueWeight> production_weights(
     const Scene& scene, BidirAlgorithm algorithm, MisHeuristic heuristic, float light_paths,
     float radius, const ExplicitPath& path, ScratchArena& arena, float raster_density,
@@ -41,11 +56,10 @@ std::vector<TechniqueWeight> production_weights(
     light.pdf_le(emitter.p, emitter.ng, emitter.wo, &pdf_pos, &pdf_dir);
     const LensConnection lens =
         lens_connection_of_emission(scene.camera(), emitter.p, emitter.ng, path.lens_point);
-    return {{false, 0, 2,
-             terms_light_seen_from_lens(rules, light, pmf, emitter, m).weight(rules.counts())},
-            {false, 1, 1,
-             terms_light_origin_to_camera(rules, lens, pmf * pdf_pos, raster_density)
-                 .weight(rules.counts())}};
+    return {
+        weight_of(rules, false, 0, 2, terms_light_seen_from_lens(rules, light, pmf, emitter, m)),
+        weight_of(rules, false, 1, 1,
+                  terms_light_origin_to_camera(rules, lens, pmf * pdf_pos, raster_density))};
   }
 
   // Positions x0..xk; for infinite lights x0 is a point far back along the emission direction.
@@ -139,20 +153,19 @@ std::vector<TechniqueWeight> production_weights(
     scatter_update(rules, m, camera_si[1], bsdf[1], camera_si[1].wo, to_light,
                    TransportMode::Radiance, specular, pdf_fwd, guides[1]);
     const float q = probability(GuidingField::kNextEvent, 1, to_light);
-    float w;
     if (finite) {
       SurfaceInteraction emitter;
       emitter.p = x[0];
       emitter.ng = path.light_normal;
       emitter.wo = dir(0, 1);
       rules.hit(m, distance_squared(x[0], x[1]), geometric_cos(emitter, emitter.wo));
-      w = terms_emitter_hit(rules, light, pmf, x[1], to_light, &emitter, m, q)
-              .weight(rules.counts());
+      out.push_back(
+          weight_of(rules, false, 0, k + 1,
+                    terms_emitter_hit(rules, light, pmf, x[1], to_light, &emitter, m, q)));
     } else {
-      w = terms_emitter_hit(rules, light, pmf, x[1], to_light, nullptr, m, q)
-              .weight(rules.counts());
+      out.push_back(weight_of(rules, false, 0, k + 1,
+                              terms_emitter_hit(rules, light, pmf, x[1], to_light, nullptr, m, q)));
     }
-    out.push_back({false, 0, k + 1, w});
   }
   // s = 1: next event estimation from x1.
   if (connect && !delta(1)) {
@@ -167,7 +180,7 @@ std::vector<TechniqueWeight> production_weights(
     TechniqueTerms terms =
         terms_next_event(rules, light, pmf, ls, camera_si[1], bsdf[1], camera_mis[1], guides[1]);
     terms.own_factor = rules.mis(probability(GuidingField::kNextEvent, 1, to_light));
-    out.push_back({false, 1, k, terms.weight(rules.counts())});
+    out.push_back(weight_of(rules, false, 1, k, terms));
   }
   // 2 <= s <= k - 1: connections of x(s-1) and x(s).
   for (int s = 2; connect && s <= k - 1; ++s) {
@@ -176,7 +189,7 @@ std::vector<TechniqueWeight> production_weights(
         terms_connection(rules, light_si[s - 1], bsdf[s - 1], light_si[s - 1].wo, stored(s - 1),
                          camera_si[s], bsdf[s], camera_mis[s], guides[s - 1], guides[s]);
     terms.own_factor = rules.mis(probability(GuidingField::kConnection, s - 1, dir(s - 1, s)));
-    out.push_back({false, s, k + 1 - s, terms.weight(rules.counts())});
+    out.push_back(weight_of(rules, false, s, k + 1 - s, terms));
   }
   // t = 1: x(k-1) connected to the lens.
   if (connect && k >= 2 && !delta(k - 1)) {
@@ -184,15 +197,14 @@ std::vector<TechniqueWeight> production_weights(
                                                  bsdf[k - 1], light_si[k - 1].wo, stored(k - 1),
                                                  x[k], raster_density, guides[k - 1]);
     terms.own_factor = rules.mis(probability(GuidingField::kLensConnection, k - 1, dir(k - 1, k)));
-    out.push_back({false, k, 1, terms.weight(rules.counts())});
+    out.push_back(weight_of(rules, false, k, 1, terms));
   }
   // Merges at every non-delta interior vertex.
   for (int j = 1; merge && j <= k - 1; ++j) {
     if (delta(j)) continue;
-    out.push_back({true, j + 1, k + 1 - j,
-                   terms_merge(rules, light_si[j].wo, stored(j), camera_si[j], bsdf[j],
-                               camera_mis[j], guides[j])
-                       .weight(rules.counts())});
+    out.push_back(weight_of(rules, true, j + 1, k + 1 - j,
+                            terms_merge(rules, light_si[j].wo, stored(j), camera_si[j], bsdf[j],
+                                        camera_mis[j], guides[j])));
   }
   return out;
 }

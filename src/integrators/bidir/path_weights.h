@@ -32,6 +32,12 @@ struct TechniqueWeight {
   bool merge = false;
   int s = 0, t = 0;  // light / camera vertices (a merge counts the merged vertex on both sides)
   float weight = 0;
+  // The weight under the photon-mapping estimator of a pixel (TechniqueTerms::stop_own): 1 for
+  // the one technique that makes the path there, 0 for the others.
+  float stop_weight = 0;
+  // That estimator's density relative to all techniques' (its n' p' over sum_k n_k p_k): the
+  // same from every technique of the path, as the proxy correction needs (adaptive_plan.h).
+  float stop_ratio = 0;
 };
 
 // Weights of every technique of `algorithm` (Bpt, Bpm or Vcm) able to produce the path

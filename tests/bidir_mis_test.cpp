@@ -436,7 +436,9 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
     ++checked;
   }
   EXPECT_EQ(checked, paths) << c.scene << ": could not build enough paths";
-  if (connect && merge) EXPECT_GT(stop_compared, paths) << c.scene;
+  if (connect && merge) {
+    EXPECT_GT(stop_compared, paths) << c.scene;
+  }
   // Area lights seen straight from the lens (s = 0 against s = 1, t = 1) are among the paths.
   bool area_lights = false;
   for (const Light* l : scene.lights()) area_lights |= l->type() == LightType::Area;

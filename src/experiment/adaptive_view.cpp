@@ -40,7 +40,8 @@ std::string adaptive_choices_html(const ComparisonResult& result) {
     const auto& a = run.integrator_stats["adaptive"];
     o << "<h2>What " << run.integrator << " chose</h2>\n<table class=\"adaptive\"><thead><tr>"
       << "<th>after probe</th><th>light paths / pixel</th><th>connections</th>"
-      << "<th>merging pixels</th><th>path-traced pixels</th><th>predicted relVar</th>"
+      << "<th>merging pixels</th><th>path-traced pixels</th><th>photon-mapped pixels</th>"
+      << "<th>predicted relVar</th>"
       << "<th>cost (us / pixel)</th>"
       << "</tr></thead><tbody>\n";
     for (const auto& h : a["history"]) {
@@ -59,6 +60,9 @@ std::string adaptive_choices_html(const ComparisonResult& result) {
         << (h.contains("path_trace_fraction")
                 ? num(100 * number(h["path_trace_fraction"]), "%.1f%%")
                 : std::string("-"))
+        << "</td><td>"
+        << (h.contains("stop_fraction") ? num(100 * number(h["stop_fraction"]), "%.1f%%")
+                                        : std::string("-"))
         << "</td><td>" << (best ? num(number((*best)["relative_variance"]), "%.4g") : "-")
         << "</td><td>" << (best ? num(number((*best)["cost_us_per_pixel"]), "%.3g") : "-")
         << "</td></tr>\n";
@@ -73,6 +77,11 @@ std::string adaptive_choices_html(const ComparisonResult& result) {
            "alone, without light-tracing splats; blocks of "
         << a["path_trace_mask"]["block"].get<int>() << " px):</p>\n"
         << mask_svg(a["path_trace_mask"], "ptmask") << "\n";
+    if (a.contains("stop_mask"))
+      o << "<p class=\"hint\">Photon-mapping mask (white: the camera path stops at its first "
+           "non-specular vertex and merges there, ppm's estimator; blocks of "
+        << a["stop_mask"]["block"].get<int>() << " px):</p>\n"
+        << mask_svg(a["stop_mask"], "stopmask") << "\n";
   }
   return o.str();
 }

@@ -42,6 +42,10 @@ struct BidirSettings {
   // adaptive-vcm: probes record one pixel per probe_stride x probe_stride block (0: from the
   // image's size, AdaptivePlan::kProbePixels).
   int probe_stride = 0;
+  // adaptive-vcm, for experiments and tests: after each choice every pixel takes this mode
+  // (bidir::PixelMode: 0 the core, 1 the core and merging, 2 path tracing, 3 photon mapping)
+  // instead of its own; -1: each pixel's own choice.
+  int force_pixel_mode = -1;
 };
 
 // Settings shared by all integrators, and each family's own struct.

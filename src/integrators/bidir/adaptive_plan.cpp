@@ -88,6 +88,7 @@ struct PixelWork {
   // (from the probes', which make two: depth limits and early rejections make it far fewer than
   // vertices x vertices).
   double camera_vertices, connections, light_vertices_per_path, merge_queries, photons;
+  double stop_camera_vertices, stop_merge_queries, stop_photons;
 };
 
 // A pixel's share of the light paths' cost.
@@ -111,6 +112,14 @@ double base_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const Cos
 // Photon density grows with the light paths: photons per query scale with the factor.
 double merge_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
   return w.merge_queries * t.merge_query + w.photons * c.light_path_factor * t.photon;
+}
+
+// A pixel that maps photons alone: its camera vertices up to the first non-delta scattering (no
+// next event estimation there: priced as path tracing's, an upper bound), one query there, and
+// its share of the light paths.
+double stop_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
+  return w.stop_camera_vertices * t.path_tracing_vertex + w.stop_merge_queries * t.merge_query +
+         w.stop_photons * c.light_path_factor * t.photon + light_cost(c, w, t);
 }
 
 void add_roulette_diff(uint8_t* diff, const AdaptivePlan::CandidateSums& sums) {
@@ -140,18 +149,20 @@ const std::vector<AdaptivePlan::Candidate>& AdaptivePlan::candidates() {
     for (float f : kLightPathFactors)
       for (int c : kConnections)
         for (bool m : {false, true}) l.push_back({f, c, m});
+    for (float f : kLightPathFactors) l.push_back({f, 0, true, true});
     return l;
   }();
   return list;
 }
 
 AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool probe_every_iteration,
-                           int probe_stride)
+                           int probe_stride, int force_mode)
     : pixels_(size_t(width) * size_t(height)),
       width_(width),
       height_(height),
       measured_(measured_costs),
       probe_all_(probe_every_iteration),
+      force_mode_(force_mode),
       modes_(pixels_, PixelMode::Merge) {
   if (probe_stride <= 0) probe_stride = int(std::floor(std::sqrt(double(pixels_) / kProbePixels)));
   stride_ = uint32_t(std::clamp(probe_stride, 1, std::max(1, std::min(width, height))));
@@ -242,13 +253,25 @@ void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* t
   const float f2 = value * value, inv_own = 1.f / own;
   const float emitter = terms->emitter, light_trace = terms->light_trace, connect = terms->connect,
               merge = terms->merge;
+  // Photon mapping: the path's one technique there (TechniqueTerms::stop_own), no connections.
+  for (size_t j = kCoreCandidates; j < kCandidates; ++j) {
+    const float q_candidate = terms->stop_denominator(1.f, table_.merge[j]);
+    const bool made = q_candidate > 0 && std::isfinite(q_candidate);
+    const float ratio = made ? q / q_candidate : 0.f;
+    const float own_g = value * ratio, scale = terms->stop_own(1.f, table_.merge[j]) * inv_own;
+    const float g = own_g * scale;
+    sums.u[j] += own_g * own_g * scale - f2 * ratio;
+    sums.r[j] += g;  // 0 for connections, whatever their share
+    sums.d[j] =
+        sums.d[j] + f2 * ratio - g * g + (made ? 0.f : std::numeric_limits<float>::infinity());
+  }
   std::array<float, kCandidates>& sum = share == Share::None           ? sums.r
                                         : share == Share::OwnLightPath ? sums.s0
                                                                        : sums.s1;
   // Written without branches, so that the loop vectorises (with -fno-trapping-math for this
   // file: src/CMakeLists.txt). A candidate none of whose techniques makes this path (Q' = 0)
   // would miss the energy: ratio 0, and D becomes infinite.
-  for (size_t j = 0; j < kCandidates; ++j) {
+  for (size_t j = 0; j < kCoreCandidates; ++j) {
     const float q_candidate = own_count[j] + emitter + table_.light_trace[j] * light_trace +
                               table_.connect[j] * connect + table_.merge[j] * merge;
     const bool made = q_candidate > 0;
@@ -314,6 +337,9 @@ void add_counts(ProbeWork& total, const ProbeWork& w) {
   total.connections += w.connections;
   total.merge_queries += w.merge_queries;
   total.photons += w.photons;
+  total.stop_camera_vertices += w.stop_camera_vertices;
+  total.stop_merge_queries += w.stop_merge_queries;
+  total.stop_photons += w.stop_photons;
 }
 
 void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means,
@@ -325,7 +351,10 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   // The cost model's photons are those of one light path per pixel (merge_cost scales them
   // with a candidate's factor); a sparse probe traces the chosen light paths.
   ProbeWork normalized = w;
-  if (w.light_paths > 0) normalized.photons *= double(pixels_) / w.light_paths;
+  if (w.light_paths > 0) {
+    normalized.photons *= double(pixels_) / w.light_paths;
+    normalized.stop_photons *= double(pixels_) / w.light_paths;
+  }
   add_counts(work_, normalized);
   work_.light_seconds += w.light_seconds;
   work_.camera_seconds += w.camera_seconds;
@@ -442,16 +471,29 @@ std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector
 
 void AdaptivePlan::choose(const std::vector<float>& means) {
   const std::vector<Candidate>& list = candidates();
-  const size_t k = list.size();
+  const size_t k = kCoreCandidates;
   const double probes = double(probes_), pixels = double(grid_pixels_);
   const PixelWork pw{work_.camera_vertices / (probes * pixels),
                      work_.connections / (probes * pixels * kProbeConnections),
                      work_.light_paths > 0 ? work_.light_vertices / work_.light_paths : 0.0,
-                     work_.merge_queries / (probes * pixels), work_.photons / (probes * pixels)};
+                     work_.merge_queries / (probes * pixels),
+                     work_.photons / (probes * pixels),
+                     work_.stop_camera_vertices / (probes * pixels),
+                     work_.stop_merge_queries / (probes * pixels),
+                     work_.stop_photons / (probes * pixels)};
   const CostModel t = costs_of(work_, measured_);
   update_roulette_factors(means);
   const std::vector<double> correction = shared_firefly_correction(means);
   const std::vector<double> pt = relative_variances(0, means, correction);
+  // Photon mapping per light-path factor (kLightPathFactors' order).
+  std::array<std::vector<double>, kStopCandidates> stop;
+  for (size_t i = 0; i < kStopCandidates; ++i)
+    stop[i] = relative_variances(kCoreCandidates + i, means, correction);
+  auto stop_index = [&](float factor) {
+    for (size_t i = 0; i < kStopCandidates; ++i)
+      if (list[kCoreCandidates + i].light_path_factor == factor) return i;
+    return kStopCandidates;
+  };
   // Candidates compare by the pixels where their variance is infinite (energy they would miss:
   // paths none of their techniques there can make), then by score. Path tracing is the
   // default only among equals.
@@ -475,18 +517,25 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     const double traced = path_tracing_cost(c, pw, t);
     const std::vector<double> no_merge = j == 0 ? pt : relative_variances(j, means, correction);
     const std::vector<double> merge = j == 0 ? pt : relative_variances(j + 1, means, correction);
+    const size_t si = j == 0 ? kStopCandidates : stop_index(c.light_path_factor);
+    const std::vector<double>* stops = si < kStopCandidates ? &stop[si] : nullptr;
+    const double stopped = stops ? stop_cost(list[kCoreCandidates + si], pw, t) : 0.0;
     // Per pixel, the option of lowest variance x cost: path tracing alone (where it is as good
     // as the light paths' techniques, it is cheaper: a caustic that only light paths make need
     // not make every pixel pay for the bidirectional core), the core, or the core and merging.
-    // Per block of pixels: finite variance, cost, variance without and with merging
-    // everywhere, pixels of infinite variance.
-    std::vector<std::array<double, 5>> blocks((grid_pixels_ + kPixelBlock - 1) / kPixelBlock);
+    // Photon mapping alone where it beats the core (ppm's estimator: a caustic seen on a
+    // diffuse surface needs no connections or light tracing there).
+    // Per block of pixels: finite variance, cost, variance without and with merging and with
+    // photon mapping everywhere, pixels of infinite variance.
+    std::vector<std::array<double, 6>> blocks((grid_pixels_ + kPixelBlock - 1) / kPixelBlock);
     for_pixel_blocks(grid_pixels_, [&](size_t b, size_t begin, size_t end) {
-      std::array<double, 5> sum{};
+      std::array<double, 6> sum{};
       for (size_t p = begin; p < end; ++p) {
         const double v0 = no_merge[p], v1 = merge[p], vt = pt[p];
+        const double vs = stops ? (*stops)[p] : std::numeric_limits<double>::infinity();
         sum[2] += v0;
         sum[3] += v1;
+        sum[5] += vs;
         // The core, with merging where that is better; path tracing where it beats both.
         double v = v0, pixel_cost = cost;
         modes[p] = PixelMode::Bidirectional;
@@ -494,6 +543,11 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
           v = v1;
           pixel_cost = cost + extra;
           modes[p] = PixelMode::Merge;
+        }
+        if (vs * stopped < v * pixel_cost) {
+          v = vs;
+          pixel_cost = stopped;
+          modes[p] = PixelMode::Stop;
         }
         if (j == 0 || (vt * traced <= v * pixel_cost && std::isfinite(vt) &&
                        vt <= kPathTracingPixelMargin * std::min(v0, v1))) {
@@ -510,13 +564,14 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
       }
       blocks[b] = sum;
     });
-    double variance = 0, total_cost = 0, variance0 = 0, variance1 = 0, missing = 0;
-    for (const std::array<double, 5>& sum : blocks) {
+    double variance = 0, total_cost = 0, variance0 = 0, variance1 = 0, missing = 0, variance_s = 0;
+    for (const std::array<double, 6>& sum : blocks) {
       variance += sum[0];
       total_cost += sum[1];
       variance0 += sum[2];
       variance1 += sum[3];
       missing += sum[4];
+      variance_s += sum[5];
     }
     const Score score{missing, variance * total_cost};
     table.push_back({{"light_path_factor", c.light_path_factor},
@@ -526,13 +581,18 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
                      {"relative_variance", variance / pixels},
                      {"relative_variance_no_merge", variance0 / pixels},
                      {"relative_variance_all_merge", variance1 / pixels},
+                     {"stop_fraction", fraction_of(modes, PixelMode::Stop)},
+                     {"relative_variance_all_stop", stops ? variance_s / pixels : -1.0},
+                     {"cost_us_per_pixel_stop", stopped},
                      {"cost_us_per_pixel", total_cost / pixels},
                      {"pixels_missing_energy", missing},
                      {"roulette_factor", roulette_[j]},
                      {"roulette_factor_merge", j == 0 ? roulette_[j] : roulette_[j + 1]},
                      {"score", score.value}});
     if (j == 0) path_tracing = score;
-    if (score < best) {
+    // A forced mode other than path tracing needs light paths (force_mode_).
+    const bool excluded = j == 0 && force_mode_ >= 0 && force_mode_ != int(PixelMode::PathTrace);
+    if (score < best && !excluded) {
       best = score;
       best_j = j;
       best_modes = modes;
@@ -540,12 +600,14 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     }
     if (j == 0) pt_variances = variances;
   }
-  if (best_j != 0 && path_tracing.missing == best.missing &&
+  if (best_j != 0 && force_mode_ < 0 && path_tracing.missing == best.missing &&
       path_tracing.value <= kPathTracingMargin * best.value) {
     best_j = 0;
     std::fill(best_modes.begin(), best_modes.end(), PixelMode::PathTrace);
     best_variances = pt_variances;
   }
+  if (force_mode_ >= 0 && best_j != 0)
+    std::fill(best_modes.begin(), best_modes.end(), PixelMode(force_mode_));
   chosen_j_ = best_j;
   chosen_variance_ = std::move(best_variances);
   const Candidate& c = list[best_j];
@@ -567,6 +629,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
                       {"connections", c.connections},
                       {"merge_fraction", fraction_of(modes_, PixelMode::Merge)},
                       {"path_trace_fraction", fraction_of(modes_, PixelMode::PathTrace)},
+                      {"stop_fraction", fraction_of(modes_, PixelMode::Stop)},
                       {"costs_us",
                        {{"camera_vertex", t.camera_vertex},
                         {"path_tracing_vertex", t.path_tracing_vertex},

@@ -55,9 +55,12 @@
 namespace caustica::bidir {
 
 // What a pixel does in an iteration that follows a choice (not a probe): the bidirectional
-// core's camera subpaths without or with merging, or path tracing alone (pt's estimator; no
-// light-tracing splat lands in the pixel, so its MIS weights are pt's).
-enum class PixelMode : uint8_t { Bidirectional = 0, Merge = 1, PathTrace = 2 };
+// core's camera subpaths without or with merging, path tracing alone (pt's estimator; no
+// light-tracing splat lands in the pixel, so its MIS weights are pt's), or photon mapping alone
+// (ppm's estimator: the camera subpath ends at its first vertex scattered through a non-delta
+// lobe and merges there, emitters count only through delta chains; no light-tracing splat
+// lands in the pixel, every weight is 1).
+enum class PixelMode : uint8_t { Bidirectional = 0, Merge = 1, PathTrace = 2, Stop = 3 };
 
 // What one iteration renders.
 struct IterationPlan {
@@ -83,16 +86,22 @@ struct IterationPlan {
   }
   bool merges(size_t pixel) const {
     return light_paths > 0 &&
-           (merge_everywhere || records(pixel) || (modes && (*modes)[pixel] == PixelMode::Merge));
+           (merge_everywhere || records(pixel) ||
+            (modes && ((*modes)[pixel] == PixelMode::Merge || (*modes)[pixel] == PixelMode::Stop)));
+  }
+  bool stops(size_t pixel) const {
+    return light_paths > 0 && !merge_everywhere && !records(pixel) && modes &&
+           (*modes)[pixel] == PixelMode::Stop;
   }
   bool path_traces(size_t pixel) const {
     return !records(pixel) && (light_paths == 0 || (!merge_everywhere && modes &&
                                                     (*modes)[pixel] == PixelMode::PathTrace));
   }
   bool any_merge() const {
-    return light_paths > 0 &&
-           (merge_everywhere || probe ||
-            (modes && std::find(modes->begin(), modes->end(), PixelMode::Merge) != modes->end()));
+    return light_paths > 0 && (merge_everywhere || probe ||
+                               (modes && std::any_of(modes->begin(), modes->end(), [](PixelMode m) {
+                                  return m == PixelMode::Merge || m == PixelMode::Stop;
+                                })));
   }
 };
 
@@ -103,6 +112,9 @@ struct ProbeWork {
   double camera_vertices = 0, nondelta_camera_vertices = 0;
   double connections = 0;  // light vertices a camera vertex was connected to
   double merge_queries = 0, photons = 0;
+  // Of those, what photon mapping in the pixel would do: the camera vertices up to the first
+  // one scattered through a non-delta lobe, and the query there with its photons.
+  double stop_camera_vertices = 0, stop_merge_queries = 0, stop_photons = 0;
   double light_seconds = 0, camera_seconds = 0, connect_seconds = 0, merge_seconds = 0;
 };
 
@@ -117,8 +129,9 @@ class AdaptivePlan {
   AdaptivePlan() = default;
   // probe_stride: record one pixel in each probe_stride x probe_stride block in probes (0: the
   // stride for the image's size, kProbePixels).
+  // force_mode >= 0: every pixel takes that PixelMode after each choice (experiments, tests).
   AdaptivePlan(int width, int height, bool measured_costs, bool probe_every_iteration = false,
-               int probe_stride = 0);
+               int probe_stride = 0, int force_mode = -1);
   // A probe renders its configuration (two connections per camera vertex, merging) and records
   // every contribution; both cost about twice what a chosen iteration costs, and on a large
   // image a probe is long beside the render (door-ajar at 640 x 480, 20 s, before this bound: 4
@@ -155,7 +168,10 @@ class AdaptivePlan {
   // probe's own counts it is the sample's (sum F)^2. Light-tracing splats come first
   // (add_light_trace, in a fixed order), then the pixel's task continues from pixel_start()
   // with add() and hands the sums back with pixel_end().
-  static constexpr size_t kCandidates = 41;
+  // Path tracing, then (light paths, connections) each without and with merging, then photon
+  // mapping (PixelMode::Stop) per light-path factor.
+  static constexpr size_t kCoreCandidates = 41, kStopCandidates = 4;
+  static constexpr size_t kCandidates = kCoreCandidates + kStopCandidates;
   static constexpr int kProbeConnections = 2;  // the pixel's own light path and a random one
   enum class Share { None, OwnLightPath, RandomLightPath };  // of a connection
   // u: the Russian-roulette difference (roulette_diff_): sum over contributions of
@@ -195,6 +211,7 @@ class AdaptivePlan {
     float light_path_factor = 0;  // light paths / pixels
     int connections = 0;
     bool merge = false;
+    bool stop = false;  // photon mapping (PixelMode::Stop)
   };
   static const std::vector<Candidate>& candidates();
 
@@ -231,6 +248,7 @@ class AdaptivePlan {
   std::vector<T> on_grid(const std::vector<T>& image) const;
   bool measured_ = false;
   bool probe_all_ = false;
+  int force_mode_ = -1;
   // pixels x candidates: the sum over probes of the second-moment estimates, as float24 (3 bytes
   // each, core/compact_float.h). 2^-16 relative rounding per addition: thousands of additions
   // (every probe, every light-tracing splat) stay far below the probes' sampling noise, and far

@@ -17,6 +17,7 @@ void AdaptivePlan::report(nlohmann::json& stats) const {
   a["connections"] = chosen_.connections;
   a["merge_fraction"] = fraction_of(modes_, PixelMode::Merge);
   a["path_trace_fraction"] = fraction_of(modes_, PixelMode::PathTrace);
+  a["stop_fraction"] = fraction_of(modes_, PixelMode::Stop);
   a["history"] = history_;
   a["checks"] = checks_;
   // The masks, block-averaged to at most 64 x 64 cells.
@@ -35,6 +36,7 @@ void AdaptivePlan::report(nlohmann::json& stats) const {
   };
   a["merge_mask"] = mask(PixelMode::Merge);
   a["path_trace_mask"] = mask(PixelMode::PathTrace);
+  a["stop_mask"] = mask(PixelMode::Stop);  // photon mapping alone
   stats["adaptive"] = a;
 }
 

@@ -25,6 +25,7 @@ Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pc
   PixelAccumulator acc;
   acc.pixel = sample.pixel;
   acc.filter_weight = sample.filter_weight;
+  acc.stops = tech_.adaptive && it.plan.stops(sample.pixel);
   if (techniques_.enabled()) acc.techniques = &techniques_;
   const bool records = it.plan.records(sample.pixel);
   acc.rules = path_traces ? &it.rules_camera_only : &it.rules_at(sample.pixel);
@@ -111,6 +112,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   bool weighted = false;  // the last emitter weight came from terms
   auto emitter_weight = [&](const Light& light, const SurfaceInteraction* hit, const MisSums& m) {
     weighted = false;
+    if (acc.stops) return specular_path ? 1.f : 0.f;  // ppm's: no light-tracing splat here
     if (depth == 0) {
       if (!hit || !tech_.light_origin || through_interface || light.type() != LightType::Area)
         return 1.f;
@@ -156,6 +158,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
 
     const bool delta = bsdf.is_delta();
     ++acc.work.camera_vertices;
+    if (specular_path) ++acc.work.stop_camera_vertices;  // photon mapping would come this far
     const VertexGuides guides = tech_.guided ? guiding_.at(si.p, si.ng, bsdf) : VertexGuides{};
     const VertexProbabilities probabilities = tech_.guided && !delta
                                                   ? guiding_.probabilities_at(si.p, si.ng, &guides)
@@ -188,7 +191,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     }
     // PPM / lt: the non-delta part of this vertex was estimated by merging (or belongs to light
     // tracing); only its delta lobes carry the camera path on.
-    if (tech_.camera_stops && !delta && !step->specular) break;
+    if ((tech_.camera_stops || acc.stops) && !delta && !step->specular) break;
     specular_path = specular_path && step->specular;
     eta_scale *= sqr(step->eta);
     if (beta.is_black()) break;
@@ -211,6 +214,10 @@ void BidirIntegrator::vertex_techniques(const Scene& scene, const Iteration& it,
   const MisRules& rules = *acc.rules;
   const bool timed = acc.plan && settings_.bidir.measured_costs;
   ++acc.work.nondelta_camera_vertices;
+  if (acc.stops) {  // ppm's estimator: merging alone, unweighted
+    merge(scene, it, rules, v, acc);
+    return;
+  }
   if (tech_.connect) {
     next_event(scene, rules, v, rng, acc);
     const auto t0 = timed ? std::chrono::steady_clock::now() : Clock::time_point{};
@@ -349,11 +356,15 @@ void BidirIntegrator::merge(const Scene& scene, const Iteration& it, const MisRu
   const Bsdf& bsdf = cv.bsdf;
   const int depth = cv.depth;
   ++acc.work.merge_queries;
+  // The query photon mapping in this pixel would make (at the first non-delta scattering).
+  const bool stop_query = !cv.mis.past_delta_chain;
+  acc.work.stop_merge_queries += stop_query;
   const int max_depth = settings_.max_depth;
   const Scene::PrimitiveRange own_shape = scene.shape_primitives(si);
   const float max_off_plane = 0.5f * it.radius;
   grid_.for_each_near(si.p, vertices_, [&](uint32_t index, Vec3 q) {
     ++acc.work.photons;
+    acc.work.stop_photons += stop_query;
     const LightVertex& stored = vertices_[index];
     const int light_depth = light_vertex_depth(stored);
     if (light_depth + depth - 1 > max_depth) return;
@@ -370,6 +381,11 @@ void BidirIntegrator::merge(const Scene& scene, const Iteration& it, const MisRu
     if (!own_shape.contains(v.primitive) &&
         !photon_visible(scene, si, v.primitive, q, v.wo, it.radius))
       return;
+    if (acc.stops) {  // a pixel no probe records: no terms needed
+      acc.add(true, light_depth + 1, depth + 1,
+              cv.beta * f * v.throughput * it.merge_normalization);
+      return;
+    }
     const TechniqueTerms terms = terms_merge(rules, v.wo, v.mis, si, bsdf, cv.mis, cv.guides);
     const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
     acc.add(true, light_depth + 1, depth + 1,

@@ -119,6 +119,8 @@ struct PixelAccumulator {
   size_t pixel = 0;
   uint64_t nonfinite = 0;
   float filter_weight = 1;  // the camera sample's pixel-filter weight (pixel_filter.h)
+  // adaptive-vcm's photon-mapping pixels (PixelMode::Stop): ppm's estimator, every weight 1.
+  bool stops = false;
   // Probe iterations of adaptive-vcm: each contribution with its MIS terms, and the work.
   AdaptivePlan* plan = nullptr;
   AdaptivePlan::CandidateSums candidate_sums;

@@ -90,7 +90,8 @@ void BidirIntegrator::prepare(const Scene& scene, Film& film) {
   }
   if (tech_.adaptive)
     plan_ = AdaptivePlan(film.width(), film.height(), settings_.bidir.measured_costs,
-                         settings_.bidir.probe_every_iteration, settings_.bidir.probe_stride);
+                         settings_.bidir.probe_every_iteration, settings_.bidir.probe_stride,
+                         settings_.bidir.force_pixel_mode);
   if (tech_.adaptive && !techniques_.enabled())
     path_tracer_ = std::make_unique<PathTracer>(settings_);
   if (tech_.adaptive) segment_.reset(film.pixel_count());

@@ -237,24 +237,24 @@ bool BidirIntegrator::splat_lens_connection(const Camera& camera, const Iteratio
                                             uint32_t technique, const ValueOf& value_of,
                                             const TermsOf& terms_of, LightChunk& chunk) const {
   const size_t first_splat = chunk.splats.size();
-  filter_.for_each_pixel(raster, camera.width(), camera.height(),
-                         [&](int x, int y, const FilterSample& fs) {
-                           const uint32_t pixel = uint32_t(y * camera.width() + x);
-                           if (tech_.adaptive && it.plan.path_traces(pixel))
-                             return;  // pt's estimator alone there
-                           const MisRules& rules = it.rules_at(pixel);
-                           const TechniqueTerms terms = terms_of(rules, fs.pdf);
-                           const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
-                           const Rgb value = value_of(w) * (fs.weight * fs.pdf);
-                           if (value.is_black()) return;
-                           if (!value.is_finite()) {
-                             ++chunk.nonfinite;
-                             return;
-                           }
-                           chunk.splats.push_back({pixel, technique, value});
-                           // The plan prices the recorded pixels' splats (append_chunk).
-                           if (it.plan.records(pixel)) chunk.splat_terms.push_back(terms);
-                         });
+  filter_.for_each_pixel(
+      raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
+        const uint32_t pixel = uint32_t(y * camera.width() + x);
+        if (tech_.adaptive && (it.plan.path_traces(pixel) || it.plan.stops(pixel)))
+          return;  // pt's or ppm's estimator alone there
+        const MisRules& rules = it.rules_at(pixel);
+        const TechniqueTerms terms = terms_of(rules, fs.pdf);
+        const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
+        const Rgb value = value_of(w) * (fs.weight * fs.pdf);
+        if (value.is_black()) return;
+        if (!value.is_finite()) {
+          ++chunk.nonfinite;
+          return;
+        }
+        chunk.splats.push_back({pixel, technique, value});
+        // The plan prices the recorded pixels' splats (append_chunk).
+        if (it.plan.records(pixel)) chunk.splat_terms.push_back(terms);
+      });
   return chunk.splats.size() > first_splat;
 }
 

@@ -149,7 +149,7 @@ const std::vector<AdaptivePlan::Candidate>& AdaptivePlan::candidates() {
     for (float f : kLightPathFactors)
       for (int c : kConnections)
         for (bool m : {false, true}) l.push_back({f, c, m});
-    for (float f : kLightPathFactors) l.push_back({f, 0, true, true});
+    for (float f : kLightPathFactors) l.push_back({f, 0, true});  // photon mapping
     return l;
   }();
   return list;

@@ -210,8 +210,7 @@ class AdaptivePlan {
   struct Candidate {
     float light_path_factor = 0;  // light paths / pixels
     int connections = 0;
-    bool merge = false;
-    bool stop = false;  // photon mapping (PixelMode::Stop)
+    bool merge = false;  // from kCoreCandidates on: photon mapping (PixelMode::Stop)
   };
   static const std::vector<Candidate>& candidates();
 

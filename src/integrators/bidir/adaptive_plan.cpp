@@ -33,10 +33,29 @@ struct CostModel {
   // veach-bidir 5.0, mis-plates 1.75, coffee 2.7; at 0.75 the model predicted 1.25x less).
   double path_tracing_vertex = 0.6;
   double light_vertex = 1.1;  // trace, BSDF, store, connect to the lens
-  double connection = 0.6;    // one light vertex connected to one camera vertex
-  double merge_query = 0.18;  // one range query
-  double photon = 0.03;       // one photon gathered
+  // One light vertex connected to one camera vertex: of a light path drawn at random, and of
+  // the pixel's own light path, which costs less. The fit above had one connection, the
+  // pixel's own, and four: its slope is the random ones'. Measured 2026-12-04 (door-ajar
+  // 160 x 120, 2 threads, adaptive-vcm's core at fixed configurations, thread-microseconds per
+  // pixel and iteration from "checks"): 1, 2, 4 connections at one light path per pixel 5.88,
+  // 8.78, 14.19, none 3.81, so the first 0.32 us, each further one 0.42-0.45, against a
+  // camera vertex of 0.54 (0.45 and 0.6 at this model's 0.75). Priced alike, the model
+  // preferred two connections, or none, to one (door-ajar: 1.18x bpt's relMSE over 4 seeds).
+  double connection = 0.6;
+  double own_connection = 0.45;
+  // One range query at up to one light path per pixel; above that its price grows with the
+  // light paths (query_price): the grid and the vertices it points to outgrow the caches.
+  // door-ajar, as above: a query, the grid's build shared among them included, took 0.19 us
+  // at one light path per pixel and 0.43 at two, beside a camera vertex of 0.54 (0.26 and 0.6
+  // at this model's 0.75; the fit above gave 0.18, which priced merging at two light paths
+  // per pixel at half of what it took).
+  double merge_query = 0.25;
+  double photon = 0.03;  // one photon gathered
 };
+
+double query_price(const AdaptivePlan::Candidate& c, const CostModel& t) {
+  return t.merge_query * std::max(1.0, double(c.light_path_factor));
+}
 constexpr float kLightPathFactors[] = {0.25f, 0.5f, 1.f, 2.f};
 constexpr int kConnections[] = {0, 1, 2, 4, 8};
 constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
@@ -71,7 +90,11 @@ CostModel costs_of(const ProbeWork& w, bool measured) {
   t.path_tracing_vertex =
       t.camera_vertex * (CostModel{}.path_tracing_vertex / CostModel{}.camera_vertex);
   t.light_vertex = per(w.light_seconds, w.light_vertices, t.light_vertex);
-  t.connection = per(w.connect_seconds, w.connections, t.connection);
+  // A probe's connections are half to the pixel's own light path, half to random ones, timed
+  // together: split in the model's proportion.
+  const double own = CostModel{}.own_connection / CostModel{}.connection;
+  t.connection = per(w.connect_seconds, w.connections, t.connection) * 2.0 / (1.0 + own);
+  t.own_connection = own * t.connection;
   // Queries and photons share one clock: split it in the model's proportion.
   const double model = w.merge_queries * t.merge_query + w.photons * t.photon;
   if (model > 0 && w.merge_seconds > 0) {
@@ -105,20 +128,22 @@ double path_tracing_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, c
 // A pixel that runs the bidirectional core (without merging).
 double base_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
   if (c.light_path_factor == 0) return path_tracing_cost(c, w, t);
-  return w.camera_vertices * t.camera_vertex + light_cost(c, w, t) +
-         c.connections * w.connections * t.connection;
+  const double connections =
+      c.connections > 0 ? t.own_connection + (c.connections - 1) * t.connection : 0.0;
+  return w.camera_vertices * t.camera_vertex + light_cost(c, w, t) + w.connections * connections;
 }
 
-// Photon density grows with the light paths: photons per query scale with the factor.
+// Photon density grows with the light paths: photons per query scale with the factor, and so
+// does a query's price above one light path per pixel (CostModel::merge_query).
 double merge_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
-  return w.merge_queries * t.merge_query + w.photons * c.light_path_factor * t.photon;
+  return w.merge_queries * query_price(c, t) + w.photons * c.light_path_factor * t.photon;
 }
 
 // A pixel that maps photons alone: its camera vertices up to the first non-delta scattering (no
 // next event estimation there: priced as path tracing's, an upper bound), one query there, and
 // its share of the light paths.
 double stop_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
-  return w.stop_camera_vertices * t.path_tracing_vertex + w.stop_merge_queries * t.merge_query +
+  return w.stop_camera_vertices * t.path_tracing_vertex + w.stop_merge_queries * query_price(c, t) +
          w.stop_photons * c.light_path_factor * t.photon + light_cost(c, w, t);
 }
 
@@ -343,7 +368,8 @@ void add_counts(ProbeWork& total, const ProbeWork& w) {
 }
 
 void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means,
-                                const std::vector<double>& measured, double iterations) {
+                                const std::vector<double>& measured, double iterations,
+                                double thread_seconds) {
   ++probes_;
   // The light-tracing sums (6 bytes per pixel and candidate) are only needed while a probe
   // renders; released before the choice, so that its buffers do not add to them.
@@ -363,13 +389,13 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   if (means.size() != pixels_) return;
   const std::vector<float> grid_means = on_grid(means);
   if (measured.size() == pixels_ && chosen_j_ < kCandidates)
-    check_last_choice(on_grid(measured), iterations, grid_means);
+    check_last_choice(on_grid(measured), iterations, thread_seconds, grid_means);
   // A choice needs the film's means (from the iterations before the probe) and two probes.
   if (probes_ >= kFirstProbes || probe_all_) choose(grid_means);
 }
 
 void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double iterations,
-                                     const std::vector<float>& means) {
+                                     double thread_seconds, const std::vector<float>& means) {
   // The measured relative variance, pooled as the prediction was; both capped at the
   // prediction's 99.5th percentile, so that a firefly that one segment happened to render (or
   // that the prediction's winsorising took out) does not decide the comparison alone.
@@ -398,7 +424,12 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
                      {"connections", candidates()[chosen_j_].connections},
                      {"iterations", iterations},
                      {"measured_relative_variance", measured_total / double(grid_pixels_)},
-                     {"predicted_relative_variance", predicted_total / double(grid_pixels_)}});
+                     {"predicted_relative_variance", predicted_total / double(grid_pixels_)},
+                     // Not deterministic (a clock); with the fixed cost model the two differ by
+                     // the machine's speed, so compare their ratio across choices.
+                     {"measured_us_per_pixel",
+                      iterations > 0 ? 1e6 * thread_seconds / (iterations * double(pixels_)) : 0.0},
+                     {"predicted_us_per_pixel", chosen_cost_}});
 }
 
 double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means) const {
@@ -506,6 +537,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   };
   Score best, path_tracing;
   size_t best_j = 0;
+  double best_cost = 0, pt_cost = 0;
   std::vector<PixelMode> modes(grid_pixels_), best_modes(grid_pixels_, PixelMode::PathTrace);
   std::vector<double> variances(grid_pixels_), best_variances(grid_pixels_), pt_variances;
   nlohmann::json table = nlohmann::json::array();
@@ -597,19 +629,25 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
       best_j = j;
       best_modes = modes;
       best_variances = variances;
+      best_cost = total_cost / pixels;
     }
-    if (j == 0) pt_variances = variances;
+    if (j == 0) {
+      pt_variances = variances;
+      pt_cost = total_cost / pixels;
+    }
   }
   if (best_j != 0 && force_mode_ < 0 && path_tracing.missing == best.missing &&
       path_tracing.value <= kPathTracingMargin * best.value) {
     best_j = 0;
     std::fill(best_modes.begin(), best_modes.end(), PixelMode::PathTrace);
     best_variances = pt_variances;
+    best_cost = pt_cost;
   }
   if (force_mode_ >= 0 && best_j != 0)
     std::fill(best_modes.begin(), best_modes.end(), PixelMode(force_mode_));
   chosen_j_ = best_j;
   chosen_variance_ = std::move(best_variances);
+  chosen_cost_ = best_cost;
   const Candidate& c = list[best_j];
   chosen_ = {};
   chosen_.light_paths = uint64_t(std::llround(double(c.light_path_factor) * double(pixels_)));
@@ -635,6 +673,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
                         {"path_tracing_vertex", t.path_tracing_vertex},
                         {"light_vertex", t.light_vertex},
                         {"connection", t.connection},
+                        {"own_connection", t.own_connection},
                         {"merge_query", t.merge_query},
                         {"photon", t.photon}}},
                       {"candidates", table}});

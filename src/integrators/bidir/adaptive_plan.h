@@ -197,9 +197,11 @@ class AdaptivePlan {
   // choice ("checks"), not used to choose. A few iterations measure a heavy tail low (13 scenes
   // at 160 pixels wide, 64 spp: measured / predicted 0.08-1.14 after 3 iterations, 0.80-1.26
   // after 31 except water-caustic's 1.64), so a correction from them would keep a choice that
-  // happened to render well.
+  // happened to render well. thread_seconds: what those iterations took (wall seconds times
+  // threads), reported beside the cost predicted for the choice.
   void finish_probe(const ProbeWork& work, const std::vector<float>& means,
-                    const std::vector<double>& measured = {}, double iterations = 0);
+                    const std::vector<double>& measured = {}, double iterations = 0,
+                    double thread_seconds = 0);
 
   // "adaptive": the configuration, the history of choices (each with its candidate table and
   // costs), and the fractions of merging and of path-traced pixels in blocks of at most 64 x 64
@@ -230,7 +232,7 @@ class AdaptivePlan {
   void choose(const std::vector<float>& means);
   // Reports the last choice's measured and predicted relative variances (finish_probe).
   void check_last_choice(const std::vector<double>& measured, double iterations,
-                         const std::vector<float>& means);
+                         double thread_seconds, const std::vector<float>& means);
 
   size_t pixels_ = 0;  // the image's
   int width_ = 0, height_ = 0;
@@ -296,6 +298,7 @@ class AdaptivePlan {
   // mode the pixel took), to check against what rendering it shows.
   size_t chosen_j_ = kCandidates;
   std::vector<double> chosen_variance_;
+  double chosen_cost_ = 0;  // its predicted microseconds per pixel and iteration
   std::vector<nlohmann::json> checks_;  // one per check_last_choice(), for the report
   std::vector<nlohmann::json> history_;
 };

@@ -346,6 +346,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
   double light_seconds_total_ = 0;   // of seconds_total_, tracing light paths (with their splats)
   double camera_seconds_total_ = 0;  // of seconds_total_, tracing camera paths
   double probe_seconds_total_ = 0;   // of seconds_total_, adaptive-vcm's probe iterations
+  // adaptive-vcm: thread-seconds of the iterations since the last probe (the last choice's), for
+  // the plan's check of its predicted cost.
+  double segment_thread_seconds_ = 0;
   ProbeWork work_total_;             // operations counted over all iterations (counts only)
   std::vector<std::string> technique_files_;
 

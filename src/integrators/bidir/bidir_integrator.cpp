@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <tbb/task_arena.h>
 
 #include "film/film.h"
 #include "integrators/bidir/bidir_core.h"
@@ -195,7 +196,9 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
     if (work.light_seconds == 0) work.light_seconds = light_seconds;
     if (work.camera_seconds == 0 && it.plan.probe_stride == 1)
       work.camera_seconds = seconds_since(camera_start);
-    plan_.finish_probe(work, means_before, measured, measured_iterations);
+    plan_.finish_probe(work, means_before, measured, measured_iterations,
+                       segment_thread_seconds_);
+    segment_thread_seconds_ = 0;
   } else if (tech_.adaptive) {
     segment_.end_iteration(film);
   }
@@ -207,6 +210,8 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   seconds_total_ += seconds;
   if (it.plan.probe) probe_seconds_total_ += seconds;
+  if (tech_.adaptive && !it.plan.probe)
+    segment_thread_seconds_ += seconds * double(tbb::this_task_arena::max_concurrency());
 }
 
 void BidirIntegrator::finish(const Scene& scene, Film& film) {

@@ -298,7 +298,7 @@ class AdaptivePlan {
   // mode the pixel took), to check against what rendering it shows.
   size_t chosen_j_ = kCandidates;
   std::vector<double> chosen_variance_;
-  double chosen_cost_ = 0;  // its predicted microseconds per pixel and iteration
+  double chosen_cost_ = 0;              // its predicted microseconds per pixel and iteration
   std::vector<nlohmann::json> checks_;  // one per check_last_choice(), for the report
   std::vector<nlohmann::json> history_;
 };

@@ -349,7 +349,7 @@ class BidirIntegrator final : public CameraPathIntegrator {
   // adaptive-vcm: thread-seconds of the iterations since the last probe (the last choice's), for
   // the plan's check of its predicted cost.
   double segment_thread_seconds_ = 0;
-  ProbeWork work_total_;             // operations counted over all iterations (counts only)
+  ProbeWork work_total_;  // operations counted over all iterations (counts only)
   std::vector<std::string> technique_files_;
 
   // guided-bpt / guided-vcm: the learned fields, and per-pass pixel moments for their schedule

@@ -1,10 +1,11 @@
 #include "integrators/bidir/bidir_integrator.h"
 
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
-#include <tbb/task_arena.h>
 
 #include "film/film.h"
 #include "integrators/bidir/bidir_core.h"
@@ -196,8 +197,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
     if (work.light_seconds == 0) work.light_seconds = light_seconds;
     if (work.camera_seconds == 0 && it.plan.probe_stride == 1)
       work.camera_seconds = seconds_since(camera_start);
-    plan_.finish_probe(work, means_before, measured, measured_iterations,
-                       segment_thread_seconds_);
+    plan_.finish_probe(work, means_before, measured, measured_iterations, segment_thread_seconds_);
     segment_thread_seconds_ = 0;
   } else if (tech_.adaptive) {
     segment_.end_iteration(film);

@@ -260,6 +260,22 @@ TEST(AdaptiveVcm, WhatAChoiceShowsMatchesWhatWasPredictedForIt) {
     const double expected_iterations[] = {3, 7, 15, 31};
     for (size_t i = 0; i < checks.size(); ++i)
       EXPECT_EQ(checks[i]["iterations"].get<double>(), expected_iterations[i]);
+    // Each check's predicted cost is that of the choice it checks: the candidate of the choice
+    // made after the previous probe, with the modes its pixels took.
+    for (const auto& check : checks) {
+      const int probe = check["after_probe"].get<int>() - 1;
+      const nlohmann::json* choice = nullptr;
+      for (const auto& h : stats["adaptive"]["history"])
+        if (h["after_probe"].get<int>() == probe) choice = &h;
+      ASSERT_NE(choice, nullptr);
+      double cost = -1;
+      for (const auto& c : (*choice)["candidates"])
+        if (c["light_path_factor"] == (*choice)["light_path_factor"] &&
+            c["connections"] == (*choice)["connections"])
+          cost = c["cost_us_per_pixel"].get<double>();
+      EXPECT_DOUBLE_EQ(check["predicted_us_per_pixel"].get<double>(), cost) << name;
+      EXPECT_GT(check["measured_us_per_pixel"].get<double>(), 0.0) << name;
+    }
     const auto& last = checks.back();
     const double ratio = last["measured_relative_variance"].get<double>() /
                          last["predicted_relative_variance"].get<double>();

@@ -93,8 +93,10 @@ CostModel costs_of(const ProbeWork& w, bool measured) {
   // A probe's connections are half to the pixel's own light path, half to random ones, timed
   // together: split in the model's proportion.
   const double own = CostModel{}.own_connection / CostModel{}.connection;
-  t.connection = per(w.connect_seconds, w.connections, t.connection) * 2.0 / (1.0 + own);
-  t.own_connection = own * t.connection;
+  if (w.connections > 0 && w.connect_seconds > 0) {
+    t.connection = per(w.connect_seconds, w.connections, t.connection) * 2.0 / (1.0 + own);
+    t.own_connection = own * t.connection;
+  }
   // Queries and photons share one clock: split it in the model's proportion.
   const double model = w.merge_queries * t.merge_query + w.photons * t.photon;
   if (model > 0 && w.merge_seconds > 0) {

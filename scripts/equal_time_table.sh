@@ -3,8 +3,11 @@
 # equal time per integrator on 2 threads (caustica compare, seed 0) against a vcm reference
 # (seed 7919, 1 thread; two references render at once), then one markdown table.
 #
-#   scripts/equal_time_table.sh OUT [SECONDS] [REFERENCE_SECONDS] [INTEGRATORS]
+#   scripts/equal_time_table.sh OUT [SECONDS] [REFERENCE_SECONDS] [INTEGRATORS] [RESOLUTION]
 #
+# RESOLUTION: small (default: 160 pixels wide, the resolutions listed below) or native (each
+# scene's own Film resolution: 2-16x the pixels, so fewer iterations and fewer probes in the
+# same time).
 # References already in OUT/refs are kept (delete them after a change to the integrators'
 # images). Run it on an otherwise idle machine: the compare runs are timed.
 set -euo pipefail
@@ -12,6 +15,11 @@ out=${1:?usage: equal_time_table.sh OUT [SECONDS] [REFERENCE_SECONDS] [INTEGRATO
 seconds=${2:-20}
 ref_seconds=${3:-300}
 integrators=${4:-pt,bpt,ppm,vcm,adaptive-vcm}
+resolution=${5:-small}
+[[ $resolution == small || $resolution == native ]] || {
+  echo "RESOLUTION is small or native" >&2
+  exit 2
+}
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${CAUSTICA:-$root/build/apps/caustica/caustica}
 mkdir -p "$out/refs"
@@ -34,11 +42,18 @@ scenes=(
   "water-caustic scenes/pbrt-v4/water-caustic/scene-v4.pbrt 160x160"
 )
 
+# The --resolution option of a scene's runs (none at its own resolution).
+resolution_of() {
+  [[ $resolution == small ]] && echo "--resolution $1"
+  return 0
+}
+
 reference() {
   local name=$1 file=$2 res=$3
   [[ -f "$out/refs/$name.exr" ]] && return 0
+  # shellcheck disable=SC2046
   "$bin" reference "$root/$file" --integrator vcm --time "$ref_seconds" --threads 1 \
-    --resolution "$res" --outfile "$out/refs/$name.exr" 2>"$out/refs/$name.log"
+    $(resolution_of "$res") --outfile "$out/refs/$name.exr" 2>"$out/refs/$name.log"
 }
 
 # References, two at a time.
@@ -57,7 +72,8 @@ wait
 for s in "${scenes[@]}"; do
   read -r name file res <<<"$s"
   echo "compare $name" >&2
-  "$bin" compare "$root/$file" --resolution "$res" --time "$seconds" --threads 2 --seed 0 \
+  # shellcheck disable=SC2046
+  "$bin" compare "$root/$file" $(resolution_of "$res") --time "$seconds" --threads 2 --seed 0 \
     --integrators "$integrators" --reference "$out/refs/$name.exr" --out "$out/$name" \
     >"$out/$name.log" 2>&1
 done

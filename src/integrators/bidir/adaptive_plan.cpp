@@ -3,7 +3,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <bit>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -61,7 +60,6 @@ constexpr int kConnections[] = {0, 1, 2, 4, 8};
 constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
 constexpr int kBlurRadius = 3;        // pixel variances pooled over 7 x 7 (box_blur)
 constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
-constexpr int kFirstProbes = 2;
 // Path tracing is kept unless another configuration's predicted relVar x time is lower by more
 // than this factor. The cost model has no term for the per-iteration costs of light paths (their
 // pipeline, the splats), and the predicted variances carry a few percent of noise: on mis-plates
@@ -216,8 +214,66 @@ std::vector<T> AdaptivePlan::on_grid(const std::vector<T>& image) const {
 }
 
 bool AdaptivePlan::is_probe(uint32_t iteration) const {
-  // 0, 1, 3, 7, 15, 31, ...
-  return probe_all_ || iteration < kFirstProbes || std::has_single_bit(uint64_t(iteration) + 1);
+  return probe_all_ || iteration < kFirstProbes || iteration == next_probe_;
+}
+
+void AdaptivePlan::schedule_next_probe() {
+  const uint64_t probe = probes_ <= kFirstProbes ? uint64_t(probes_ - 1) : next_probe_;
+  const double choice = chosen_cost_, probe_cost = probe_cost_;
+  // The predicted cost of the iterations up to this probe (those since the last probe at the
+  // choice they rendered, and this probe; before the first choice every iteration was a
+  // probe), and of what the probes cost beyond the choice they stood in for: their samples are
+  // the image's as much as the choice's are.
+  if (probe_iterations_.empty()) {
+    spent_cost_ = double(probe + 1) * probe_cost;
+    probe_excess_ = double(probe + 1) * std::max(0.0, probe_cost - choice);
+  } else {
+    spent_cost_ += double(probe - probe_iterations_.back() - 1) * last_choice_cost_ + probe_cost;
+    probe_excess_ += std::max(0.0, probe_cost - last_choice_cost_);
+  }
+  probe_iterations_.push_back(probe);
+  last_choice_cost_ = choice;
+  // The doubling where there is no price, and with measured costs: those differ between MPI
+  // ranks, which must agree on the probes (every rank renders them, and at a fixed --spp they
+  // meet before each one).
+  uint64_t gap = probe + 1;
+  if (choice > 0 && probe_cost > 0 && !measured_) {
+    // The next probe comes once the iterations after this one, the next probe included, have
+    // cost what everything up to this one did: with one cost per iteration, iteration 2i + 1
+    // after a probe at i (3, 7, 15, ...), and where the choice is much cheaper than a probe
+    // (path tracing beside a probe's full VCM with two connections: 5x its cost on coffee) as
+    // much later.
+    gap = uint64_t(std::ceil(std::max(1.0, (spent_cost_ - probe_cost) / choice)));
+    // No probe whose excess would take the probes beyond kMaxProbeShare of the render's
+    // predicted cost (the rest of the budget at this choice): at 3, 7, 15, ... they took 22-35%
+    // of 20 s at the scenes' own resolutions where the choice was cheap.
+    const double rest = remaining_cost(probe, choice);
+    if (std::isfinite(rest) &&
+        probe_excess_ + std::max(0.0, probe_cost - choice) > kMaxProbeShare * (spent_cost_ + rest))
+      gap = std::numeric_limits<uint32_t>::max();
+  }
+  next_probe_ = probe + 1 + gap;
+  if (!history_.empty() && history_.back()["after_probe"] == probes_)
+    history_.back()["next_probe"] = next_probe_ <= std::numeric_limits<uint32_t>::max()
+                                        ? nlohmann::json(next_probe_)
+                                        : nlohmann::json(nullptr);
+}
+
+void AdaptivePlan::set_budget(double iterations, double seconds, double elapsed) {
+  budget_iterations_ = iterations;
+  budget_seconds_ = seconds;
+  elapsed_seconds_ = elapsed;
+}
+
+double AdaptivePlan::remaining_cost(uint64_t probe, double choice) const {
+  // Infinite where no budget is known (the probes' share is then not bounded).
+  double rest = std::numeric_limits<double>::infinity();
+  if (budget_iterations_ > 0)  // --spp: the iterations after this probe, at the choice
+    rest = std::max(0.0, budget_iterations_ - double(probe + 1)) * choice;
+  if (budget_seconds_ > 0 && elapsed_seconds_ > 0)  // --time: the seconds left, at this pace
+    rest = std::min(
+        rest, std::max(0.0, budget_seconds_ - elapsed_seconds_) * spent_cost_ / elapsed_seconds_);
+  return rest;
 }
 
 IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
@@ -388,12 +444,16 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   work_.camera_seconds += w.camera_seconds;
   work_.connect_seconds += w.connect_seconds;
   work_.merge_seconds += w.merge_seconds;
-  if (means.size() != pixels_) return;
+  if (means.size() != pixels_) {
+    if (probes_ >= kFirstProbes) schedule_next_probe();
+    return;
+  }
   const std::vector<float> grid_means = on_grid(means);
   if (measured.size() == pixels_ && chosen_j_ < kCandidates)
     check_last_choice(on_grid(measured), iterations, thread_seconds, grid_means);
   // A choice needs the film's means (from the iterations before the probe) and two probes.
   if (probes_ >= kFirstProbes || probe_all_) choose(grid_means);
+  if (probes_ >= kFirstProbes) schedule_next_probe();
 }
 
 void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double iterations,
@@ -664,7 +724,20 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
       modes_[size_t(y) * width_ + x] = best_modes[gy * grid_w_ + gx];
     }
   }
+  // A probe's predicted cost: its recorded pixels at the probe's configuration (one light path
+  // per pixel, two connections, merging), times what recording every contribution adds; the
+  // others at the choice, with the probe's light paths (at least kSparseProbeLightPaths).
+  const Candidate probe_config{1.f, kProbeConnections, true};
+  const double recorded = double(grid_pixels_) / double(pixels_);
+  const double choice_paths = double(chosen_.light_paths) / double(pixels_);
+  const double probe_paths =
+      stride_ > 1 ? std::clamp(choice_paths, kSparseProbeLightPaths, 1.0) : choice_paths;
+  probe_cost_ = recorded * (base_cost(probe_config, pw, t) + merge_cost(probe_config, pw, t)) *
+                    kProbeRecordingFactor +
+                (1 - recorded) * (best_cost + (probe_paths - choice_paths) *
+                                                  pw.light_vertices_per_path * t.light_vertex);
   history_.push_back({{"after_probe", probes_},
+                      {"predicted_probe_us_per_pixel", probe_cost_},
                       {"light_path_factor", c.light_path_factor},
                       {"connections", c.connections},
                       {"merge_fraction", fraction_of(modes_, PixelMode::Merge)},

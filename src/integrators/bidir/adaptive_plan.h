@@ -26,11 +26,14 @@
 // that misses energy (infinite variance: paths none of its techniques make) in the fewest pixels,
 // and among those has the lowest total.
 //
-// Probes are iterations 0, 1, 3, 7, 15, 31, ... (2^k - 1): their cost fades as the render
-// grows. On an image of more than kProbePixels pixels a probe records one pixel per block of
-// the image and the estimates below are of that grid of pixels; the others render the last
-// choice (IterationPlan::records), with its light paths (kSparseProbeLightPaths to one per
-// pixel) once there is one. The first choice is made after the second probe; the variance
+// Probes are iterations 0 and 1, then each once the iterations since the last one have cost
+// (predicted by the fixed model) what everything before it did, so their cost fades as the
+// render grows (with one cost per iteration: 3, 7, 15, 31, ...), and none that would take the
+// probes beyond kMaxProbeShare of the budget's predicted time in excess of the choice they stand
+// in for (schedule_next_probe). On an image of more than kProbePixels pixels a probe records one
+// pixel per block of the image and the estimates below are of that grid of pixels; the others
+// render the last choice (IterationPlan::records), with its light paths (kSparseProbeLightPaths to
+// one per pixel) once there is one. The first choice is made after the second probe; the variance
 // all candidates share is winsorised at its 99.5th percentile over the pixels (a shared firefly
 // must not decide) and pooled over 7 x 7 neighbours before the per-pixel decision (a handful of
 // samples per pixel would otherwise decide by luck; an infinite variance makes its whole window
@@ -144,9 +147,23 @@ class AdaptivePlan {
   // pass had cost up to 3x the chosen one: mirror-caustic at 640 x 480 chose half a light path
   // per pixel), at least this many and at most one per pixel.
   static constexpr double kSparseProbeLightPaths = 0.5;
+  // Probes are iterations 0 and 1, then each after the iterations since the last one have cost
+  // (predicted) what everything before it did (schedule_next_probe): with one cost per
+  // iteration, iterations 3, 7, 15, 31, ...
+  static constexpr int kFirstProbes = 2;
+  // What recording every contribution for every candidate adds to a probe's pixels (measured on
+  // cornell-caustics 160x160, 1 thread: a probe 399 ms against 224 ms for vcm --connections 2,
+  // docs/adaptive-vcm.md "What a probe costs").
+  static constexpr double kProbeRecordingFactor = 1.78;
+  // The most of the predicted time that the probes may take beyond the choice they replace.
+  static constexpr double kMaxProbeShare = 0.1;
   int probe_stride() const { return int(stride_); }
 
   bool is_probe(uint32_t iteration) const;
+  // The render's budget, before each probe is finished: iterations (a fixed --spp) or seconds
+  // (--time) with the seconds spent so far; 0 where unknown. The probes' share of the time is
+  // bounded by what the budget predicts (schedule_next_probe).
+  void set_budget(double iterations, double seconds, double elapsed);
   IterationPlan plan(uint32_t iteration) const;
 
   // Recording a probe. A pixel's estimate in a probe is the sum of its contributions F_i, each
@@ -230,6 +247,12 @@ class AdaptivePlan {
   std::vector<double> relative_variances(size_t j, const std::vector<float>& means,
                                          const std::vector<double>& correction) const;
   void choose(const std::vector<float>& means);
+  // After a probe: when the next one comes (next_probe_), from the predicted costs of the
+  // probes and of the choice.
+  void schedule_next_probe();
+  // The predicted cost of the budget's iterations after the probe at `probe` at cost `choice`
+  // (infinite without a budget).
+  double remaining_cost(uint64_t probe, double choice) const;
   // Reports the last choice's measured and predicted relative variances (finish_probe).
   void check_last_choice(const std::vector<double>& measured, double iterations,
                          double thread_seconds, const std::vector<float>& means);
@@ -290,7 +313,15 @@ class AdaptivePlan {
     }
   } table_;
   int probes_ = 0;
-  ProbeWork work_;  // summed over probes
+  // The probes' schedule (is_probe): the iteration of the next probe after the first two, the
+  // iterations probed so far, and the predicted microseconds per pixel of every iteration up to
+  // the last probe and of the last choice (schedule_next_probe).
+  uint64_t next_probe_ = kFirstProbes;
+  std::vector<uint64_t> probe_iterations_;
+  double spent_cost_ = 0, last_choice_cost_ = 0, probe_excess_ = 0;
+  double probe_cost_ = 0;  // a probe's predicted microseconds per pixel (choose)
+  double budget_iterations_ = 0, budget_seconds_ = 0, elapsed_seconds_ = 0;  // set_budget
+  ProbeWork work_;                                                           // summed over probes
   std::vector<PixelMode> modes_;
   IterationPlan chosen_;
   // The last choice: its candidate (the index of its entry without merging; 0: path tracing;

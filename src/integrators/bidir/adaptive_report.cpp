@@ -9,6 +9,7 @@ namespace caustica::bidir {
 void AdaptivePlan::report(nlohmann::json& stats) const {
   nlohmann::json a;
   a["probes"] = probes_;
+  a["probe_iterations"] = probe_iterations_;  // from the second on (the first is iteration 0)
   // A probe records one pixel per probe_stride x probe_stride block (1: every pixel); the
   // candidates' variances and pixel counts are of those pixels.
   a["probe_stride"] = stride_;

@@ -197,6 +197,8 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
     if (work.light_seconds == 0) work.light_seconds = light_seconds;
     if (work.camera_seconds == 0 && it.plan.probe_stride == 1)
       work.camera_seconds = seconds_since(camera_start);
+    plan_.set_budget(std::max(0, budget_spp()), budget_seconds(),
+                     seconds_total_ + seconds_since(start));
     plan_.finish_probe(work, means_before, measured, measured_iterations, segment_thread_seconds_);
     segment_thread_seconds_ = 0;
   } else if (tech_.adaptive) {

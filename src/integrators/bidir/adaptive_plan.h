@@ -127,6 +127,9 @@ double fraction_of(const std::vector<PixelMode>& modes, PixelMode mode);
 // Adds w's operation counts (not its seconds) to total.
 void add_counts(ProbeWork& total, const ProbeWork& w);
 
+struct PixelWork;  // adaptive_costs.h
+struct CostModel;
+
 class AdaptivePlan {
  public:
   AdaptivePlan() = default;
@@ -246,7 +249,12 @@ class AdaptivePlan {
   // Per pixel: candidate j's relative variance, corrected and pooled over neighbours.
   std::vector<double> relative_variances(size_t j, const std::vector<float>& means,
                                          const std::vector<double>& correction) const;
+  // Scores every candidate from the probes so far and takes the best (adaptive_choice.cpp).
   void choose(const std::vector<float>& means);
+  // Takes candidate j with one mode per grid pixel (chosen_, modes_, chosen_j_).
+  void take_choice(size_t j, const std::vector<PixelMode>& grid_modes);
+  // A probe's predicted microseconds per pixel after a choice (probe_cost_).
+  void predict_probe_cost(const PixelWork& pw, const CostModel& t);
   // After a probe: when the next one comes (next_probe_), from the predicted costs of the
   // probes and of the choice.
   void schedule_next_probe();

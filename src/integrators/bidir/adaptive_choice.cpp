@@ -1,0 +1,362 @@
+// Choosing adaptive-vcm's configuration from the probes (AdaptivePlan::choose): every
+// candidate's per-pixel relative variance from the recorded second moments, each pixel's mode of
+// lowest variance x cost, the candidate of lowest total, and the check of the last choice against
+// what rendering it showed (adaptive_plan.h).
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "core/compact_float.h"
+#include "integrators/bidir/adaptive_costs.h"
+#include "integrators/bidir/adaptive_plan.h"
+#include "integrators/bidir/grid_statistics.h"
+
+namespace caustica::bidir {
+
+namespace {
+constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
+constexpr int kBlurRadius = 3;        // pixel variances pooled over 7 x 7 (box_blur)
+constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
+// Path tracing is kept unless another configuration's predicted relVar x time is lower by more
+// than this factor. The cost model has no term for the per-iteration costs of light paths (their
+// pipeline, the splats), and the predicted variances carry a few percent of noise: on mis-plates
+// a quarter of the light paths won by 0.25% of the score while `pt` was 1.09x (20 s) and 1.15x
+// (60 s) better. The margin changes no choice where a configuration is predicted 5% better.
+constexpr double kPathTracingMargin = 1.05;
+// A pixel path traces alone only where its predicted variance is at most this much above the
+// core's: the prediction is that of path tracing under the balance heuristic (the candidate
+// without light paths) while pt's estimator uses the power heuristic, and a pixel's rare bright
+// paths are the least predictable part. 20 s, 1 thread, seeds 0 / 1, relMSE: veach-mis without
+// the bound 0.000696 / 0.000692, with 1.0 0.000620 / 0.000584, with 1.1 0.000684 / 0.000643
+// (before pixels could path trace: 0.000666 / 0.000622); sun-glass 0.000339 / 0.000324,
+// 0.000586 / 0.000420, 0.000362 / 0.000320; material-spheres 0.000257 / 0.000278, 0.000264 /
+// 0.000276, 0.000253 / 0.000257.
+constexpr double kPathTracingPixelMargin = 1.1;
+
+// One candidate's decision per pixel, and its sums over the pixels.
+struct PixelChoice {
+  std::vector<PixelMode> modes;
+  std::vector<double> variances;  // of the mode each pixel took
+  double variance = 0;            // the finite ones'
+  double cost = 0;                // microseconds per iteration
+  double missing = 0;             // pixels of infinite variance
+  double variance_no_merge = 0, variance_all_merge = 0, variance_all_stop = 0;
+};
+
+// What a pixel costs per iteration in each mode under one candidate.
+struct ModePrices {
+  double core = 0, merge_extra = 0, path_traced = 0, stopped = 0;
+};
+
+// Per pixel, the option of lowest variance x cost: path tracing alone (where it is as good as the
+// light paths' techniques, it is cheaper: a caustic that only light paths make need not make
+// every pixel pay for the bidirectional core), the core, or the core and merging; photon mapping
+// alone where it beats the core (ppm's estimator: a caustic seen on a diffuse surface needs no
+// connections or light tracing there). stops: photon mapping's variances (none: not an option);
+// path_tracing_only: the candidate without light paths.
+PixelChoice choose_pixel_modes(const std::vector<double>& no_merge,
+                               const std::vector<double>& merge, const std::vector<double>& pt,
+                               const std::vector<double>* stops, const ModePrices& price,
+                               bool path_tracing_only) {
+  const size_t n = pt.size();
+  PixelChoice out;
+  out.modes.resize(n);
+  out.variances.resize(n);
+  // Per block of pixels: finite variance, cost, variance without and with merging and with
+  // photon mapping everywhere, pixels of infinite variance.
+  std::vector<std::array<double, 6>> blocks((n + kPixelBlock - 1) / kPixelBlock);
+  for_pixel_blocks(n, [&](size_t b, size_t begin, size_t end) {
+    std::array<double, 6> sum{};
+    for (size_t p = begin; p < end; ++p) {
+      const double v0 = no_merge[p], v1 = merge[p], vt = pt[p];
+      const double vs = stops ? (*stops)[p] : std::numeric_limits<double>::infinity();
+      sum[2] += v0;
+      sum[3] += v1;
+      sum[5] += vs;
+      // The core, with merging where that is better; path tracing where it beats both.
+      double v = v0, pixel_cost = price.core;
+      out.modes[p] = PixelMode::Bidirectional;
+      if (v1 * (price.core + price.merge_extra) < v0 * price.core) {
+        v = v1;
+        pixel_cost = price.core + price.merge_extra;
+        out.modes[p] = PixelMode::Merge;
+      }
+      if (vs * price.stopped < v * pixel_cost) {
+        v = vs;
+        pixel_cost = price.stopped;
+        out.modes[p] = PixelMode::Stop;
+      }
+      if (path_tracing_only || (vt * price.path_traced <= v * pixel_cost && std::isfinite(vt) &&
+                                vt <= kPathTracingPixelMargin * std::min(v0, v1))) {
+        v = vt;
+        pixel_cost = price.path_traced;
+        out.modes[p] = PixelMode::PathTrace;
+      }
+      out.variances[p] = v;
+      if (std::isfinite(v))
+        sum[0] += v;
+      else
+        sum[4] += 1;
+      sum[1] += pixel_cost;
+    }
+    blocks[b] = sum;
+  });
+  for (const std::array<double, 6>& sum : blocks) {
+    out.variance += sum[0];
+    out.cost += sum[1];
+    out.variance_no_merge += sum[2];
+    out.variance_all_merge += sum[3];
+    out.missing += sum[4];
+    out.variance_all_stop += sum[5];
+  }
+  return out;
+}
+
+// Candidates compare by the pixels where their variance is infinite (energy they would miss:
+// paths none of their techniques there can make), then by score (relative variance x time).
+struct Score {
+  double missing = std::numeric_limits<double>::infinity();
+  double value = std::numeric_limits<double>::infinity();
+  bool operator<(const Score& o) const {
+    return missing != o.missing ? missing < o.missing : value < o.value;
+  }
+};
+
+// A row of the report's candidate table (history[].candidates).
+nlohmann::json candidate_row(const AdaptivePlan::Candidate& c, const PixelChoice& choice,
+                             const ModePrices& price, bool stops, double pixels, double roulette,
+                             double roulette_merge, const Score& score) {
+  return {{"light_path_factor", c.light_path_factor},
+          {"connections", c.connections},
+          {"merge_fraction", fraction_of(choice.modes, PixelMode::Merge)},
+          {"path_trace_fraction", fraction_of(choice.modes, PixelMode::PathTrace)},
+          {"relative_variance", choice.variance / pixels},
+          {"relative_variance_no_merge", choice.variance_no_merge / pixels},
+          {"relative_variance_all_merge", choice.variance_all_merge / pixels},
+          {"stop_fraction", fraction_of(choice.modes, PixelMode::Stop)},
+          {"relative_variance_all_stop", stops ? choice.variance_all_stop / pixels : -1.0},
+          {"cost_us_per_pixel_stop", price.stopped},
+          {"cost_us_per_pixel", choice.cost / pixels},
+          {"pixels_missing_energy", choice.missing},
+          {"roulette_factor", roulette},
+          {"roulette_factor_merge", roulette_merge},
+          {"score", score.value}};
+}
+}  // namespace
+
+void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double iterations,
+                                     double thread_seconds, const std::vector<float>& means) {
+  // The measured relative variance, pooled as the prediction was; both capped at the
+  // prediction's 99.5th percentile, so that a firefly that one segment happened to render (or
+  // that the prediction's winsorising took out) does not decide the comparison alone.
+  std::vector<double> relative(grid_pixels_);
+  for (size_t p = 0; p < grid_pixels_; ++p)
+    relative[p] = measured[p] / (double(means[p]) * means[p] + kRelEps);
+  relative = box_blur(relative, grid_w_, grid_h_, kBlurRadius);
+  const double cap = finite_quantile(chosen_variance_, kWinsorize);
+  std::vector<std::array<double, 2>> blocks((grid_pixels_ + kPixelBlock - 1) / kPixelBlock);
+  for_pixel_blocks(grid_pixels_, [&](size_t b, size_t begin, size_t end) {
+    std::array<double, 2> sum{};
+    for (size_t p = begin; p < end; ++p) {
+      if (!std::isfinite(chosen_variance_[p]) || !std::isfinite(relative[p])) continue;
+      sum[0] += std::min(relative[p], cap);
+      sum[1] += std::min(chosen_variance_[p], cap);
+    }
+    blocks[b] = sum;
+  });
+  double measured_total = 0, predicted_total = 0;
+  for (const std::array<double, 2>& sum : blocks) {
+    measured_total += sum[0];
+    predicted_total += sum[1];
+  }
+  checks_.push_back({{"after_probe", probes_},
+                     {"light_path_factor", candidates()[chosen_j_].light_path_factor},
+                     {"connections", candidates()[chosen_j_].connections},
+                     {"iterations", iterations},
+                     {"measured_relative_variance", measured_total / double(grid_pixels_)},
+                     {"predicted_relative_variance", predicted_total / double(grid_pixels_)},
+                     // Not deterministic (a clock); with the fixed cost model the two differ by
+                     // the machine's speed, so compare their ratio across choices.
+                     {"measured_us_per_pixel",
+                      iterations > 0 ? 1e6 * thread_seconds / (iterations * double(pixels_)) : 0.0},
+                     {"predicted_us_per_pixel", chosen_cost_}});
+}
+
+double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means) const {
+  const double mean = means[p];
+  const double moment = get_float24(&moments_[(p * kCandidates + j) * 3]) / double(probes_);
+  // Signed: clamped only after pooling (relative_variances).
+  return (moment - mean * mean) / (mean * mean + kRelEps) * roulette_[j];
+}
+
+void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
+  roulette_.fill(1.0);
+  // Per candidate (in parallel; each in pixel order, so deterministic): the sum of its finite
+  // relative variances and of the relative roulette differences, these winsorised at their
+  // 99.5th percentile as the shared variance is (the own techniques' estimate is heavy-tailed:
+  // on a 32 x 32 Cornell box path tracing's factor ranged 1.15-1.43 over the probes without it,
+  // against 1.07 from 400 probes).
+  tbb::parallel_for(size_t(0), kCandidates, [&](size_t j) {
+    std::vector<double> diff(grid_pixels_);
+    double variance = 0;
+    for (size_t p = 0; p < grid_pixels_; ++p) {
+      const double v = relative_variance(p, j, means);
+      diff[p] = std::numeric_limits<double>::infinity();
+      if (!std::isfinite(v)) continue;
+      variance += v;
+      diff[p] = get_float24(&roulette_diff_[(p * kCandidates + j) * 3]) /
+                (double(probes_) * (double(means[p]) * means[p] + kRelEps));
+    }
+    const double cap = finite_quantile(diff, kWinsorize);
+    double total = 0;
+    for (double d : diff)
+      if (std::isfinite(d)) total += std::min(d, cap);
+    const double factor = variance > 0 ? 1.0 + total / variance : 1.0;
+    roulette_[j] = std::isfinite(factor) ? std::max(factor, 1.0) : 1.0;
+  });
+}
+
+std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<float>& means) const {
+  // The part of a pixel's variance every candidate has (the least of them) is winsorised at its
+  // 99.5th percentile over the pixels: a firefly that a few probes saw in a handful of pixels,
+  // and that every candidate shares, is mostly estimation noise; at full weight it drowns the
+  // differences everywhere else and lets the cheapest candidate win. What a candidate has beyond
+  // the least (its own fireflies: missing connections, fewer light paths) is kept in full.
+  std::vector<double> shared(grid_pixels_);
+  for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p) {
+      double least = std::numeric_limits<double>::infinity();
+      for (size_t j = 0; j < kCandidates; ++j)
+        least = std::min(least, relative_variance(p, j, means));
+      shared[p] = least;
+    }
+  });
+  std::vector<double> sorted = shared;
+  const size_t q = std::min(grid_pixels_ - 1, size_t(double(grid_pixels_) * kWinsorize));
+  std::nth_element(sorted.begin(), sorted.begin() + q, sorted.end());
+  const double cap = sorted[q];
+  for (double& x : shared) x = std::isfinite(x) && x > cap ? cap - x : 0.0;
+  return shared;
+}
+
+std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector<float>& means,
+                                                     const std::vector<double>& correction) const {
+  std::vector<double> v(grid_pixels_);
+  for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p) v[p] = relative_variance(p, j, means) + correction[p];
+  });
+  v = box_blur(v, grid_w_, grid_h_, kBlurRadius);
+  for (double& x : v) x = std::max(x, 0.0);  // inf stays inf
+  return v;
+}
+
+void AdaptivePlan::choose(const std::vector<float>& means) {
+  const std::vector<Candidate>& list = candidates();
+  const double pixels = double(grid_pixels_);
+  const PixelWork pw = pixel_work_of(work_, double(probes_), pixels, kProbeConnections);
+  const CostModel t = costs_of(work_, measured_);
+  update_roulette_factors(means);
+  const std::vector<double> correction = shared_firefly_correction(means);
+  const std::vector<double> pt = relative_variances(0, means, correction);
+  // Photon mapping per light-path factor (kLightPathFactors' order).
+  std::array<std::vector<double>, kStopCandidates> stop;
+  for (size_t i = 0; i < kStopCandidates; ++i)
+    stop[i] = relative_variances(kCoreCandidates + i, means, correction);
+  auto stop_index = [&](float factor) {
+    for (size_t i = 0; i < kStopCandidates; ++i)
+      if (list[kCoreCandidates + i].light_path_factor == factor) return i;
+    return kStopCandidates;
+  };
+  // Path tracing is the default only among equals (kPathTracingMargin).
+  Score best, path_tracing;
+  size_t best_j = 0;
+  PixelChoice best_choice, pt_choice;
+  nlohmann::json table = nlohmann::json::array();
+  // Candidates come in (no merge, merge) pairs after path tracing at index 0.
+  for (size_t j = 0; j < kCoreCandidates; j += (j == 0 ? 1 : 2)) {
+    const Candidate& c = list[j];
+    const size_t si = j == 0 ? kStopCandidates : stop_index(c.light_path_factor);
+    const std::vector<double>* stops = si < kStopCandidates ? &stop[si] : nullptr;
+    const ModePrices price{base_cost(c, pw, t), j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t),
+                           path_tracing_cost(c, pw, t),
+                           stops ? stop_cost(list[kCoreCandidates + si], pw, t) : 0.0};
+    PixelChoice choice = j == 0 ? choose_pixel_modes(pt, pt, pt, nullptr, price, true)
+                                : choose_pixel_modes(relative_variances(j, means, correction),
+                                                     relative_variances(j + 1, means, correction),
+                                                     pt, stops, price, false);
+    const Score score{choice.missing, choice.variance * choice.cost};
+    table.push_back(candidate_row(c, choice, price, stops != nullptr, pixels, roulette_[j],
+                                  roulette_[j == 0 ? j : j + 1], score));
+    // A forced mode other than path tracing needs light paths (force_mode_).
+    const bool excluded = j == 0 && force_mode_ >= 0 && force_mode_ != int(PixelMode::PathTrace);
+    if (score < best && !excluded) {
+      best = score;
+      best_j = j;
+      best_choice = choice;
+    }
+    if (j == 0) {
+      path_tracing = score;
+      pt_choice = std::move(choice);
+    }
+  }
+  if (best_j != 0 && force_mode_ < 0 && path_tracing.missing == best.missing &&
+      path_tracing.value <= kPathTracingMargin * best.value) {
+    best_j = 0;
+    best_choice = std::move(pt_choice);  // every pixel path traces
+  }
+  if (force_mode_ >= 0 && best_j != 0)
+    std::fill(best_choice.modes.begin(), best_choice.modes.end(), PixelMode(force_mode_));
+  take_choice(best_j, best_choice.modes);
+  chosen_variance_ = std::move(best_choice.variances);
+  chosen_cost_ = best_choice.cost / pixels;
+  predict_probe_cost(pw, t);
+  const Candidate& c = list[best_j];
+  history_.push_back({{"after_probe", probes_},
+                      {"predicted_probe_us_per_pixel", probe_cost_},
+                      {"light_path_factor", c.light_path_factor},
+                      {"connections", c.connections},
+                      {"merge_fraction", fraction_of(modes_, PixelMode::Merge)},
+                      {"path_trace_fraction", fraction_of(modes_, PixelMode::PathTrace)},
+                      {"stop_fraction", fraction_of(modes_, PixelMode::Stop)},
+                      {"costs_us", to_json(t)},
+                      {"candidates", table}});
+}
+
+void AdaptivePlan::take_choice(size_t j, const std::vector<PixelMode>& grid_modes) {
+  const Candidate& c = candidates()[j];
+  chosen_j_ = j;
+  chosen_ = {};
+  chosen_.light_paths = uint64_t(std::llround(double(c.light_path_factor) * double(pixels_)));
+  chosen_.connections = c.connections;
+  chosen_.merge_everywhere = false;
+  // Each image pixel takes the mode of its block's probed pixel (the last row and column of
+  // grid pixels also cover what is left of the image beyond them).
+  for (int y = 0; y < height_; ++y) {
+    const size_t gy = std::min(size_t(y) / stride_, size_t(grid_h_ - 1));
+    for (int x = 0; x < width_; ++x) {
+      const size_t gx = std::min(size_t(x) / stride_, size_t(grid_w_ - 1));
+      modes_[size_t(y) * width_ + x] = grid_modes[gy * grid_w_ + gx];
+    }
+  }
+}
+
+void AdaptivePlan::predict_probe_cost(const PixelWork& pw, const CostModel& t) {
+  // A probe's predicted cost: its recorded pixels at the probe's configuration (one light path
+  // per pixel, two connections, merging), times what recording every contribution adds; the
+  // others at the choice, with the probe's light paths (at least kSparseProbeLightPaths).
+  const Candidate probe_config{1.f, kProbeConnections, true};
+  const double recorded = double(grid_pixels_) / double(pixels_);
+  const double choice_paths = double(chosen_.light_paths) / double(pixels_);
+  const double probe_paths =
+      stride_ > 1 ? std::clamp(choice_paths, kSparseProbeLightPaths, 1.0) : choice_paths;
+  probe_cost_ = recorded * (base_cost(probe_config, pw, t) + merge_cost(probe_config, pw, t)) *
+                    kProbeRecordingFactor +
+                (1 - recorded) * (chosen_cost_ + (probe_paths - choice_paths) *
+                                                     pw.light_vertices_per_path * t.light_vertex);
+}
+
+}  // namespace caustica::bidir

@@ -1,0 +1,82 @@
+// The price of an adaptive-vcm configuration (adaptive_plan.h): microseconds per pixel and
+// iteration of each operation, fixed (CostModel's defaults, deterministic) or measured in the
+// probes, and what a pixel costs in each PixelMode under a candidate's light paths and
+// connections, from the work the probes counted.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "integrators/bidir/adaptive_plan.h"
+
+namespace caustica::bidir {
+
+// The fixed cost model, in microseconds per operation: a least-squares fit of camera-pass and
+// light-pass times to the operation counts (statistics "work_per_iteration") of vcm and bpt at
+// 1 and 4 connections and 0.25-2 light paths per pixel on door-ajar, cornell-box, veach-bidir
+// and water-caustic (1 thread, 2-core x86-64, g++ 12 Release, 2026-11-30; per scene the camera
+// vertex ranged 0.6-1.0 us, a connection 0.5-0.7, a light vertex 0.8-2.0). Scenes whose BSDFs
+// are expensive to evaluate (coated materials: material-testball fits 2.9 / 8.6 / 4.4) are
+// mispriced; --adaptive-costs measured times the probes instead. Used whenever costs are not
+// measured, so that a render at fixed spp and seed chooses the same configurations on every
+// machine and for every thread count.
+struct CostModel {
+  double camera_vertex = 0.75;  // trace, BSDF, NEE with its shadow ray
+  // A camera vertex of a path-tracing iteration, which pt's own estimator renders (no MIS sums
+  // for other techniques): fitted so that the predicted bpt / pt cost ratio matches the
+  // measured one (1 thread, 160 px wide, 16 spp, 2026-11-30: door-ajar 5.3, cornell-box 4.1,
+  // veach-bidir 5.0, mis-plates 1.75, coffee 2.7; at 0.75 the model predicted 1.25x less).
+  double path_tracing_vertex = 0.6;
+  double light_vertex = 1.1;  // trace, BSDF, store, connect to the lens
+  // One light vertex connected to one camera vertex: of a light path drawn at random, and of
+  // the pixel's own light path, which costs less. The fit above had one connection, the
+  // pixel's own, and four: its slope is the random ones'. Measured 2026-12-04 (door-ajar
+  // 160 x 120, 2 threads, adaptive-vcm's core at fixed configurations, thread-microseconds per
+  // pixel and iteration from "checks"): 1, 2, 4 connections at one light path per pixel 5.88,
+  // 8.78, 14.19, none 3.81, so the first 0.32 us, each further one 0.42-0.45, against a
+  // camera vertex of 0.54 (0.45 and 0.6 at this model's 0.75). Priced alike, the model
+  // preferred two connections, or none, to one (door-ajar: 1.18x bpt's relMSE over 4 seeds).
+  double connection = 0.6;
+  double own_connection = 0.45;
+  // One range query at up to one light path per pixel; above that its price grows with the
+  // light paths (query_price): the grid and the vertices it points to outgrow the caches.
+  // door-ajar, as above: a query, the grid's build shared among them included, took 0.19 us
+  // at one light path per pixel and 0.43 at two, beside a camera vertex of 0.54 (0.26 and 0.6
+  // at this model's 0.75; the fit above gave 0.18, which priced merging at two light paths
+  // per pixel at half of what it took).
+  double merge_query = 0.25;
+  double photon = 0.03;  // one photon gathered
+};
+
+// The operation costs: the model, or what the probes measured (seconds summed over threads).
+CostModel costs_of(const ProbeWork& w, bool measured);
+nlohmann::json to_json(const CostModel& t);
+
+// Per pixel and iteration, from the probes' work (light paths at one per pixel).
+struct PixelWork {
+  // connections: light vertices connected per pixel with one connection per camera vertex
+  // (from the probes', which make two: depth limits and early rejections make it far fewer than
+  // vertices x vertices).
+  double camera_vertices, connections, light_vertices_per_path, merge_queries, photons;
+  double stop_camera_vertices, stop_merge_queries, stop_photons;
+};
+// Per pixel and iteration: the work `probes` probes counted over `pixels` recorded pixels, each
+// camera vertex of which made `probe_connections` connections.
+PixelWork pixel_work_of(const ProbeWork& w, double probes, double pixels, int probe_connections);
+
+// A pixel's share of the light paths' cost.
+double light_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t);
+// A pixel that path traces: pt's camera vertices, and its share of the light paths (which the
+// other pixels use).
+double path_tracing_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t);
+// A pixel that runs the bidirectional core (without merging).
+double base_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t);
+// What merging adds to it. Photon density grows with the light paths: photons per query scale
+// with the factor, and so does a query's price above one light path per pixel
+// (CostModel::merge_query).
+double merge_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t);
+// A pixel that maps photons alone: its camera vertices up to the first non-delta scattering (no
+// next event estimation there: priced as path tracing's, an upper bound), one query there, and
+// its share of the light paths.
+double stop_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t);
+
+}  // namespace caustica::bidir

@@ -275,6 +275,8 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   Score best, path_tracing;
   size_t best_j = 0;
   PixelChoice best_choice, pt_choice;
+  best_choice.modes.assign(grid_pixels_, PixelMode::PathTrace);
+  best_choice.variances.assign(grid_pixels_, 0.0);
   nlohmann::json table = nlohmann::json::array();
   // Candidates come in (no merge, merge) pairs after path tracing at index 0.
   for (size_t j = 0; j < kCoreCandidates; j += (j == 0 ? 1 : 2)) {

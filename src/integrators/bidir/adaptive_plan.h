@@ -322,8 +322,9 @@ class AdaptivePlan {
   } table_;
   int probes_ = 0;
   // The probes' schedule (is_probe): the iteration of the next probe after the first two, the
-  // iterations probed so far, and the predicted microseconds per pixel of every iteration up to
-  // the last probe and of the last choice (schedule_next_probe).
+  // iterations probed so far from the second probe on (iteration 0 is always one), and the
+  // predicted microseconds per pixel of every iteration up to the last probe and of the last
+  // choice (schedule_next_probe).
   uint64_t next_probe_ = kFirstProbes;
   std::vector<uint64_t> probe_iterations_;
   double spent_cost_ = 0, last_choice_cost_ = 0, probe_excess_ = 0;

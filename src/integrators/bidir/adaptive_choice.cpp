@@ -36,6 +36,12 @@ constexpr double kPathTracingMargin = 1.05;
 // 0.000586 / 0.000420, 0.000362 / 0.000320; material-spheres 0.000257 / 0.000278, 0.000264 /
 // 0.000276, 0.000253 / 0.000257.
 constexpr double kPathTracingPixelMargin = 1.1;
+// A candidate renders every pixel in one mode instead of its per-pixel mix only where that is
+// predicted better by more than this factor: the mix is priced with the modes that half of the
+// probes chose (cross-fitted, variant_scores), worse than those that all of them choose, so the
+// price is high by that. On cornell-glass at 48 x 48 the mix (4% of the pixels merging at the
+// caustic) and the core everywhere were priced within 0.1% of each other.
+constexpr double kMixMargin = 1.05;
 
 // One candidate's decision per pixel, and its sums over the pixels.
 struct PixelChoice {
@@ -126,26 +132,141 @@ struct Score {
   }
 };
 
-// A row of the report's candidate table (history[].candidates).
+// One candidate's per-pixel variances from one set of probes (every probe, or one half):
+// without and with merging, path tracing, photon mapping (null: not an option).
+struct PairVariances {
+  std::vector<double> no_merge, merge;
+  const std::vector<double>* pt = nullptr;
+  const std::vector<double>* stops = nullptr;
+  const std::vector<double>* of(PixelMode m) const {
+    return m == PixelMode::Bidirectional ? &no_merge
+           : m == PixelMode::Merge       ? &merge
+           : m == PixelMode::PathTrace   ? pt
+                                         : stops;
+  }
+};
+
+// The sum over pixels of the finite values of value(p), the same for any thread count.
+template <typename Fn>
+double finite_sum(size_t n, Fn&& value) {
+  std::vector<double> blocks((n + kPixelBlock - 1) / kPixelBlock);
+  for_pixel_blocks(n, [&](size_t b, size_t begin, size_t end) {
+    double sum = 0;
+    for (size_t p = begin; p < end; ++p) {
+      const double x = value(p);
+      if (std::isfinite(x)) sum += x;
+    }
+    blocks[b] = sum;
+  });
+  double total = 0;
+  for (double x : blocks) total += x;
+  return total;
+}
+
+// Every pixel in mode m (the candidate's pure options beside its per-pixel mix).
+PixelChoice uniform_choice(const PairVariances& v, PixelMode m, double pixel_cost) {
+  PixelChoice out;
+  out.variances = *v.of(m);
+  out.modes.assign(out.variances.size(), m);
+  out.variance = finite_sum(out.variances.size(), [&](size_t p) { return out.variances[p]; });
+  for (double x : out.variances) out.missing += std::isfinite(x) ? 0.0 : 1.0;
+  out.cost = pixel_cost * double(out.variances.size());
+  return out;
+}
+
+// A candidate's options: its per-pixel mix of modes, or every pixel in one mode.
+enum Variant : size_t { kMixed, kAllCore, kAllMerge, kAllStop, kVariants };
+constexpr std::array<const char*, kVariants> kVariantNames{"mixed", "bidirectional", "merge",
+                                                           "photon_mapping"};
+constexpr std::array<PixelMode, kVariants> kVariantModes{
+    PixelMode::Bidirectional, PixelMode::Bidirectional, PixelMode::Merge, PixelMode::Stop};
+
+// A row of the report's candidate table (history[].candidates): what the candidate would render
+// (choice: its option `variant`), and its per-pixel mix (mixed).
 nlohmann::json candidate_row(const AdaptivePlan::Candidate& c, const PixelChoice& choice,
-                             const ModePrices& price, bool stops, double pixels, double roulette,
-                             double roulette_merge, const Score& score) {
+                             const PixelChoice& mixed, const ModePrices& price, bool stops,
+                             double pixels, double roulette, double roulette_merge,
+                             const std::array<Score, kVariants>& scores, size_t variant,
+                             double cross_fitted) {
+  const auto score_of = [&](size_t v) {
+    return std::isfinite(scores[v].value) ? scores[v].value : -1.0;
+  };
   return {{"light_path_factor", c.light_path_factor},
           {"connections", c.connections},
           {"merge_fraction", fraction_of(choice.modes, PixelMode::Merge)},
           {"path_trace_fraction", fraction_of(choice.modes, PixelMode::PathTrace)},
           {"relative_variance", choice.variance / pixels},
-          {"relative_variance_no_merge", choice.variance_no_merge / pixels},
-          {"relative_variance_all_merge", choice.variance_all_merge / pixels},
+          {"relative_variance_no_merge", mixed.variance_no_merge / pixels},
+          {"relative_variance_all_merge", mixed.variance_all_merge / pixels},
           {"stop_fraction", fraction_of(choice.modes, PixelMode::Stop)},
-          {"relative_variance_all_stop", stops ? choice.variance_all_stop / pixels : -1.0},
+          {"relative_variance_all_stop", stops ? mixed.variance_all_stop / pixels : -1.0},
           {"cost_us_per_pixel_stop", price.stopped},
           {"cost_us_per_pixel", choice.cost / pixels},
           {"pixels_missing_energy", choice.missing},
           {"roulette_factor", roulette},
           {"roulette_factor_merge", roulette_merge},
-          {"score", score.value}};
+          {"relative_variance_mixed", mixed.variance / pixels},
+          {"relative_variance_cross_fitted", cross_fitted / pixels},
+          {"cost_us_per_pixel_mixed", mixed.cost / pixels},
+          {"variant", kVariantNames[variant]},
+          {"score_mixed", score_of(kMixed)},
+          {"score_all_core", score_of(kAllCore)},
+          {"score_all_merge", score_of(kAllMerge)},
+          {"score_all_stop", score_of(kAllStop)},
+          {"score", scores[variant].value}};
 }
+// A candidate's options scored (relative variance x time; the pixels where each misses energy)
+// from v: every probe's variances, then the even and the odd probes' (when cross). mixed: its
+// per-pixel mix from every probe. cross_fitted: the mix's variance as scored.
+std::array<Score, kVariants> variant_scores(size_t n, const std::array<PairVariances, 3>& v,
+                                            const PixelChoice& mixed, const ModePrices& price,
+                                            bool cross, bool path_tracing, double& cross_fitted) {
+  // Summed over the halves where they are known, so that every option is estimated from the
+  // same probes (a half's winsorising differs from the whole's).
+  const auto total = [&](PixelMode m) {
+    if (!cross) return finite_sum(n, [&](size_t p) { return (*v[0].of(m))[p]; });
+    return 0.5 * (finite_sum(n, [&](size_t p) { return (*v[1].of(m))[p]; }) +
+                  finite_sum(n, [&](size_t p) { return (*v[2].of(m))[p]; }));
+  };
+  // The mix is priced on the probes that did not choose it: the per-pixel minimum over noisy
+  // estimates is biased low by the noise (door-ajar at 640 x 480 predicted 7.3 for it against
+  // 24.7 for photon mapping everywhere, and rendered 2.8x worse than the latter). Each half's
+  // modes are priced on the other half; where that half saw an infinite variance (a path it
+  // happened to find), the whole's estimate for the mix's mode there stands in.
+  cross_fitted = mixed.variance;
+  if (cross && !path_tracing) {
+    const auto priced = [&](const std::vector<PixelMode>& modes, const PairVariances& other) {
+      return finite_sum(n, [&](size_t p) {
+        const double x = (*other.of(modes[p]))[p];
+        return std::isfinite(x) ? x : mixed.variances[p];
+      });
+    };
+    const PixelChoice even =
+        choose_pixel_modes(v[1].no_merge, v[1].merge, *v[1].pt, v[1].stops, price, false);
+    const PixelChoice odd =
+        choose_pixel_modes(v[2].no_merge, v[2].merge, *v[2].pt, v[2].stops, price, false);
+    cross_fitted = 0.5 * (priced(even.modes, v[2]) + priced(odd.modes, v[1]));
+  } else if (cross) {
+    cross_fitted = total(PixelMode::PathTrace);
+  }
+  std::array<Score, kVariants> scores{};
+  scores[kMixed] = {mixed.missing, cross_fitted * mixed.cost};
+  if (path_tracing) return scores;  // every pixel path traces: no other option
+  const auto count_missing = [&](PixelMode m) {
+    double missing = 0;
+    for (double x : *v[0].of(m)) missing += std::isfinite(x) ? 0.0 : 1.0;
+    return missing;
+  };
+  const std::array<double, kVariants> pixel_costs{0, price.core, price.core + price.merge_extra,
+                                                  price.stopped};
+  for (size_t k = kAllCore; k < kVariants; ++k) {
+    const PixelMode m = kVariantModes[k];
+    if (!v[0].of(m)) continue;
+    scores[k] = {count_missing(m), total(m) * pixel_costs[k] * double(n)};
+  }
+  return scores;
+}
+
 }  // namespace
 
 void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double iterations,
@@ -186,9 +307,16 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
                      {"predicted_us_per_pixel", chosen_cost_}});
 }
 
-double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means) const {
+double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means,
+                                       Half half) const {
   const double mean = means[p];
-  const double moment = get_float24(&moments_[(p * kCandidates + j) * 3]) / double(probes_);
+  const size_t i = (p * kCandidates + j) * 3;
+  const double all = get_float24(&moments_[i]);
+  const int odd_probes = probes_ / 2;
+  const double moment = half == Half::All ? all / double(probes_)
+                        : half == Half::Odd
+                            ? get_float24(&moments_odd_[i]) / double(odd_probes)
+                            : (all - get_float24(&moments_odd_[i])) / double(probes_ - odd_probes);
   // Signed: clamped only after pooling (relative_variances).
   return (moment - mean * mean) / (mean * mean + kRelEps) * roulette_[j];
 }
@@ -220,7 +348,8 @@ void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
   });
 }
 
-std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<float>& means) const {
+std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<float>& means,
+                                                            Half half) const {
   // The part of a pixel's variance every candidate has (the least of them) is winsorised at its
   // 99.5th percentile over the pixels: a firefly that a few probes saw in a handful of pixels,
   // and that every candidate shares, is mostly estimation noise; at full weight it drowns the
@@ -231,7 +360,7 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
     for (size_t p = begin; p < end; ++p) {
       double least = std::numeric_limits<double>::infinity();
       for (size_t j = 0; j < kCandidates; ++j)
-        least = std::min(least, relative_variance(p, j, means));
+        least = std::min(least, relative_variance(p, j, means, half));
       shared[p] = least;
     }
   });
@@ -244,10 +373,12 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
 }
 
 std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector<float>& means,
-                                                     const std::vector<double>& correction) const {
+                                                     const std::vector<double>& correction,
+                                                     Half half) const {
   std::vector<double> v(grid_pixels_);
   for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
-    for (size_t p = begin; p < end; ++p) v[p] = relative_variance(p, j, means) + correction[p];
+    for (size_t p = begin; p < end; ++p)
+      v[p] = relative_variance(p, j, means, half) + correction[p];
   });
   v = box_blur(v, grid_w_, grid_h_, kBlurRadius);
   for (double& x : v) x = std::max(x, 0.0);  // inf stays inf
@@ -260,12 +391,19 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   const PixelWork pw = pixel_work_of(work_, double(probes_), pixels, kProbeConnections);
   const CostModel t = costs_of(work_, measured_);
   update_roulette_factors(means);
-  const std::vector<double> correction = shared_firefly_correction(means);
-  const std::vector<double> pt = relative_variances(0, means, correction);
+  // Every probe, then the even and the odd ones alone (cross-fitting needs one in each).
+  const bool cross = probes_ >= 2;
+  const std::array<Half, 3> halves{Half::All, Half::Even, Half::Odd};
+  const size_t sets = cross ? 3 : 1;
+  std::array<std::vector<double>, 3> correction, pt;
   // Photon mapping per light-path factor (kLightPathFactors' order).
-  std::array<std::vector<double>, kStopCandidates> stop;
-  for (size_t i = 0; i < kStopCandidates; ++i)
-    stop[i] = relative_variances(kCoreCandidates + i, means, correction);
+  std::array<std::array<std::vector<double>, kStopCandidates>, 3> stop;
+  for (size_t h = 0; h < sets; ++h) {
+    correction[h] = shared_firefly_correction(means, halves[h]);
+    pt[h] = relative_variances(0, means, correction[h], halves[h]);
+    for (size_t i = 0; i < kStopCandidates; ++i)
+      stop[h][i] = relative_variances(kCoreCandidates + i, means, correction[h], halves[h]);
+  }
   auto stop_index = [&](float factor) {
     for (size_t i = 0; i < kStopCandidates; ++i)
       if (list[kCoreCandidates + i].light_path_factor == factor) return i;
@@ -273,7 +411,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   };
   // Path tracing is the default only among equals (kPathTracingMargin).
   Score best, path_tracing;
-  size_t best_j = 0;
+  size_t best_j = 0, best_variant = kMixed;
   PixelChoice best_choice, pt_choice;
   best_choice.modes.assign(grid_pixels_, PixelMode::PathTrace);
   best_choice.variances.assign(grid_pixels_, 0.0);
@@ -282,32 +420,56 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   for (size_t j = 0; j < kCoreCandidates; j += (j == 0 ? 1 : 2)) {
     const Candidate& c = list[j];
     const size_t si = j == 0 ? kStopCandidates : stop_index(c.light_path_factor);
-    const std::vector<double>* stops = si < kStopCandidates ? &stop[si] : nullptr;
+    std::array<PairVariances, 3> v;
+    for (size_t h = 0; h < sets; ++h) {
+      v[h].pt = &pt[h];
+      v[h].stops = si < kStopCandidates ? &stop[h][si] : nullptr;
+      if (j == 0) continue;
+      v[h].no_merge = relative_variances(j, means, correction[h], halves[h]);
+      v[h].merge = relative_variances(j + 1, means, correction[h], halves[h]);
+    }
     const ModePrices price{base_cost(c, pw, t), j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t),
                            path_tracing_cost(c, pw, t),
-                           stops ? stop_cost(list[kCoreCandidates + si], pw, t) : 0.0};
-    PixelChoice choice = j == 0 ? choose_pixel_modes(pt, pt, pt, nullptr, price, true)
-                                : choose_pixel_modes(relative_variances(j, means, correction),
-                                                     relative_variances(j + 1, means, correction),
-                                                     pt, stops, price, false);
-    const Score score{choice.missing, choice.variance * choice.cost};
-    table.push_back(candidate_row(c, choice, price, stops != nullptr, pixels, roulette_[j],
-                                  roulette_[j == 0 ? j : j + 1], score));
+                           v[0].stops ? stop_cost(list[kCoreCandidates + si], pw, t) : 0.0};
+    PixelChoice choice =
+        j == 0 ? choose_pixel_modes(pt[0], pt[0], pt[0], nullptr, price, true)
+               : choose_pixel_modes(v[0].no_merge, v[0].merge, pt[0], v[0].stops, price, false);
+    double cross_fitted = 0;
+    const std::array<Score, kVariants> scores =
+        variant_scores(grid_pixels_, v, choice, price, cross, j == 0, cross_fitted);
+    size_t variant = kMixed;
+    for (size_t k = kAllCore; k < kVariants; ++k) {
+      const Score needed{scores[variant].missing, scores[variant].value / kMixMargin};
+      if (scores[k] < (variant == kMixed ? needed : scores[variant])) variant = k;
+    }
+    // A forced mode (force_mode_) scores the candidates by that mode everywhere.
+    for (size_t k = kAllCore; k < kVariants && j > 0; ++k)
+      if (force_mode_ == int(kVariantModes[k])) variant = k;
+    const double pixel_cost = variant == kAllCore    ? price.core
+                              : variant == kAllMerge ? price.core + price.merge_extra
+                                                     : price.stopped;
+    PixelChoice option =
+        variant == kMixed ? choice : uniform_choice(v[0], kVariantModes[variant], pixel_cost);
+    table.push_back(candidate_row(c, option, choice, price, v[0].stops != nullptr, pixels,
+                                  roulette_[j], roulette_[j == 0 ? j : j + 1], scores, variant,
+                                  cross_fitted));
     // A forced mode other than path tracing needs light paths (force_mode_).
     const bool excluded = j == 0 && force_mode_ >= 0 && force_mode_ != int(PixelMode::PathTrace);
-    if (score < best && !excluded) {
-      best = score;
+    if (scores[variant] < best && !excluded) {
+      best = scores[variant];
       best_j = j;
-      best_choice = choice;
+      best_variant = variant;
+      best_choice = std::move(option);
     }
     if (j == 0) {
-      path_tracing = score;
+      path_tracing = scores[kMixed];
       pt_choice = std::move(choice);
     }
   }
   if (best_j != 0 && force_mode_ < 0 && path_tracing.missing == best.missing &&
       path_tracing.value <= kPathTracingMargin * best.value) {
     best_j = 0;
+    best_variant = kMixed;
     best_choice = std::move(pt_choice);  // every pixel path traces
   }
   if (force_mode_ >= 0 && best_j != 0)
@@ -321,6 +483,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
                       {"predicted_probe_us_per_pixel", probe_cost_},
                       {"light_path_factor", c.light_path_factor},
                       {"connections", c.connections},
+                      {"variant", kVariantNames[best_variant]},
                       {"merge_fraction", fraction_of(modes_, PixelMode::Merge)},
                       {"path_trace_fraction", fraction_of(modes_, PixelMode::PathTrace)},
                       {"stop_fraction", fraction_of(modes_, PixelMode::Stop)},

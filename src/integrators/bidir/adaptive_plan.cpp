@@ -64,6 +64,7 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
   grid_h_ = height > 0 ? int((uint32_t(height) - 1 - offset_) / stride_ + 1) : 0;
   grid_pixels_ = size_t(grid_w_) * size_t(grid_h_);
   moments_.assign(grid_pixels_ * kCandidates * 3, 0);  // float24 zeros
+  moments_odd_.assign(grid_pixels_ * kCandidates * 3, 0);
   roulette_diff_.assign(grid_pixels_ * kCandidates * 3, 0);
   chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
   roulette_.fill(1.0);
@@ -269,11 +270,13 @@ AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
 void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums) {
   const size_t g = grid_index(pixel);
   uint8_t* m = &moments_[g * kCandidates * 3];
+  uint8_t* odd = probes_ % 2 == 1 ? &moments_odd_[g * kCandidates * 3] : nullptr;
   for (size_t j = 0; j < kCandidates; ++j) {
     const float c = table_.connect[j], r = sums.r[j], s0 = sums.s0[j], s1 = sums.s1[j];
     const float moment = r * r + 2 * r * (s0 + (c - 1) * s1) + s0 * s0 + (c - 1) * s1 * s1 +
                          c * (c - 1) * s0 * s1 + sums.d[j];
     put_float24(m + 3 * j, get_float24(m + 3 * j) + moment);
+    if (odd) put_float24(odd + 3 * j, get_float24(odd + 3 * j) + moment);
   }
   add_roulette_diff(&roulette_diff_[g * kCandidates * 3], sums);
 }

@@ -241,14 +241,20 @@ class AdaptivePlan {
   // the second moment of a few probes minus the film's mean^2 is often negative where the
   // variance is small beside mean^2, and a clamp per pixel would bias it up by that noise
   // (relative_variances clamps after pooling).
-  double relative_variance(size_t p, size_t j, const std::vector<float>& means) const;
+  // half: the estimate from every probe, or from the even or odd ones (0, 2, ... or 1, 3, ...)
+  // alone (cross-fitting, choose()).
+  enum class Half { All, Even, Odd };
+  double relative_variance(size_t p, size_t j, const std::vector<float>& means,
+                           Half half = Half::All) const;
   // Sets roulette_ from the sums so far (see roulette_diff_).
   void update_roulette_factors(const std::vector<float>& means);
   // Per pixel: what to add to every candidate's variance to winsorise the part they share.
-  std::vector<double> shared_firefly_correction(const std::vector<float>& means) const;
+  std::vector<double> shared_firefly_correction(const std::vector<float>& means,
+                                                Half half = Half::All) const;
   // Per pixel: candidate j's relative variance, corrected and pooled over neighbours.
   std::vector<double> relative_variances(size_t j, const std::vector<float>& means,
-                                         const std::vector<double>& correction) const;
+                                         const std::vector<double>& correction,
+                                         Half half = Half::All) const;
   // Scores every candidate from the probes so far and takes the best (adaptive_choice.cpp).
   void choose(const std::vector<float>& means);
   // Takes candidate j with one mode per grid pixel (chosen_, modes_, chosen_j_).
@@ -287,6 +293,9 @@ class AdaptivePlan {
   // from where a sum stops growing. Not bfloat16: 2^-8 would lose a pixel's variance in the
   // rounding of its mean^2, and its sums would stall after a few hundred terms.
   std::vector<uint8_t> moments_;
+  // The same sums over the odd probes alone (the even ones': moments_ minus these), to
+  // cross-fit the per-pixel choice of modes (choose()).
+  std::vector<uint8_t> moments_odd_;
   // Russian roulette. The balance weights leave it out (mis.h), so a contribution is
   // F = f / (Q rho_t), rho_t the survival probability of its own subpaths, and the proxy
   // F^2 Q / Q' estimates the integral of f^2 sum_t (n_t p_t / rho_t) / (Q Q'): the probe's

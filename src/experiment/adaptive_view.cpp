@@ -31,6 +31,15 @@ std::string mask_svg(const nlohmann::json& mask, const char* css_class) {
   return grey_grid_svg(grey, w, h, std::max(1.0, 384.0 / w), css_class);
 }
 
+// A history entry's variant (adaptive_choice.cpp): each pixel's own mode, or one for all.
+std::string variant_label(const std::string& variant) {
+  if (variant == "mixed") return "per-pixel mix";
+  if (variant == "bidirectional") return "all: core, no merging";
+  if (variant == "merge") return "all: core and merging";
+  if (variant == "photon_mapping") return "all: photon mapping";
+  return variant;
+}
+
 }  // namespace
 
 std::string adaptive_choices_html(const ComparisonResult& result) {
@@ -40,6 +49,7 @@ std::string adaptive_choices_html(const ComparisonResult& result) {
     const auto& a = run.integrator_stats["adaptive"];
     o << "<h2>What " << run.integrator << " chose</h2>\n<table class=\"adaptive\"><thead><tr>"
       << "<th>after probe</th><th>light paths / pixel</th><th>connections</th>"
+      << "<th>pixels</th>"
       << "<th>merging pixels</th><th>path-traced pixels</th><th>photon-mapped pixels</th>"
       << "<th>predicted relVar</th>"
       << "<th>cost (us / pixel)</th>"
@@ -56,7 +66,9 @@ std::string adaptive_choices_html(const ComparisonResult& result) {
       o << "<tr><td>" << h["after_probe"].get<int>() << "</td><td>"
         << num(h["light_path_factor"].get<double>(), "%g") << "</td><td>"
         << h["connections"].get<int>() << "</td><td>"
-        << num(100 * number(h["merge_fraction"]), "%.1f%%") << "</td><td>"
+        << (h.contains("variant") ? variant_label(h["variant"].get<std::string>())
+                                  : std::string("-"))
+        << "</td><td>" << num(100 * number(h["merge_fraction"]), "%.1f%%") << "</td><td>"
         << (h.contains("path_trace_fraction")
                 ? num(100 * number(h["path_trace_fraction"]), "%.1f%%")
                 : std::string("-"))

@@ -181,13 +181,20 @@ constexpr std::array<const char*, kVariants> kVariantNames{"mixed", "bidirection
 constexpr std::array<PixelMode, kVariants> kVariantModes{
     PixelMode::Bidirectional, PixelMode::Bidirectional, PixelMode::Merge, PixelMode::Stop};
 
+// How a candidate's per-pixel mix is priced: its modes chosen and priced on every probe
+// (in_sample), each half's modes priced on that half (halves) and on the other half
+// (cross_fitted), and the estimate scored.
+struct MixPrice {
+  double in_sample = 0, halves = 0, cross_fitted = 0, estimate = 0;
+};
+
 // A row of the report's candidate table (history[].candidates): what the candidate would render
 // (choice: its option `variant`), and its per-pixel mix (mixed).
 nlohmann::json candidate_row(const AdaptivePlan::Candidate& c, const PixelChoice& choice,
                              const PixelChoice& mixed, const ModePrices& price, bool stops,
                              double pixels, double roulette, double roulette_merge,
                              const std::array<Score, kVariants>& scores, size_t variant,
-                             double cross_fitted) {
+                             const MixPrice& mix) {
   const auto score_of = [&](size_t v) {
     return std::isfinite(scores[v].value) ? scores[v].value : -1.0;
   };
@@ -205,8 +212,10 @@ nlohmann::json candidate_row(const AdaptivePlan::Candidate& c, const PixelChoice
           {"pixels_missing_energy", choice.missing},
           {"roulette_factor", roulette},
           {"roulette_factor_merge", roulette_merge},
-          {"relative_variance_mixed", mixed.variance / pixels},
-          {"relative_variance_cross_fitted", cross_fitted / pixels},
+          {"relative_variance_mixed", mix.estimate / pixels},
+          {"relative_variance_mixed_in_sample", mix.in_sample / pixels},
+          {"relative_variance_mixed_halves", mix.halves / pixels},
+          {"relative_variance_cross_fitted", mix.cross_fitted / pixels},
           {"cost_us_per_pixel_mixed", mixed.cost / pixels},
           {"variant", kVariantNames[variant]},
           {"score_mixed", score_of(kMixed)},
@@ -217,23 +226,21 @@ nlohmann::json candidate_row(const AdaptivePlan::Candidate& c, const PixelChoice
 }
 // A candidate's options scored (relative variance x time; the pixels where each misses energy)
 // from v: every probe's variances, then the even and the odd probes' (when cross). mixed: its
-// per-pixel mix from every probe. cross_fitted: the mix's variance as scored.
+// per-pixel mix from every probe.
 std::array<Score, kVariants> variant_scores(size_t n, const std::array<PairVariances, 3>& v,
                                             const PixelChoice& mixed, const ModePrices& price,
-                                            bool cross, bool path_tracing, double& cross_fitted) {
-  // Summed over the halves where they are known, so that every option is estimated from the
-  // same probes (a half's winsorising differs from the whole's).
-  const auto total = [&](PixelMode m) {
-    if (!cross) return finite_sum(n, [&](size_t p) { return (*v[0].of(m))[p]; });
-    return 0.5 * (finite_sum(n, [&](size_t p) { return (*v[1].of(m))[p]; }) +
-                  finite_sum(n, [&](size_t p) { return (*v[2].of(m))[p]; }));
-  };
-  // The mix is priced on the probes that did not choose it: the per-pixel minimum over noisy
-  // estimates is biased low by the noise (door-ajar at 640 x 480 predicted 7.3 for it against
-  // 24.7 for photon mapping everywhere, and rendered 2.8x worse than the latter). Each half's
-  // modes are priced on the other half; where that half saw an infinite variance (a path it
-  // happened to find), the whole's estimate for the mix's mode there stands in.
-  cross_fitted = mixed.variance;
+                                            bool cross, bool path_tracing, MixPrice& mix) {
+  // The per-pixel minimum over noisy estimates is biased low by their noise, and the modes it
+  // picks are priced by the same noise: door-ajar at 640 x 480 predicted 7.3 for its mix against
+  // 24.7 for photon mapping everywhere, and rendered 2.8x worse than the latter. So the mix is
+  // also chosen on each half of the probes and priced on the other half (where that half saw an
+  // infinite variance, a path it happened to find, the whole's estimate for the mix's mode there
+  // stands in). The excess of that price over the halves' own is the optimism of choosing on
+  // half of the probes; the noise of an estimate, and with it the optimism, falls with the
+  // square root of the probes, so the whole's mix is priced at its own estimate plus that
+  // excess / sqrt(2). (Pricing every option from the halves instead made the choice between
+  // candidates as noisy as one probe: point-room and sun-glass at 640 x 480 rendered 8-33% worse.)
+  mix.in_sample = mix.halves = mix.cross_fitted = mix.estimate = mixed.variance;
   if (cross && !path_tracing) {
     const auto priced = [&](const std::vector<PixelMode>& modes, const PairVariances& other) {
       return finite_sum(n, [&](size_t p) {
@@ -245,28 +252,25 @@ std::array<Score, kVariants> variant_scores(size_t n, const std::array<PairVaria
         choose_pixel_modes(v[1].no_merge, v[1].merge, *v[1].pt, v[1].stops, price, false);
     const PixelChoice odd =
         choose_pixel_modes(v[2].no_merge, v[2].merge, *v[2].pt, v[2].stops, price, false);
-    cross_fitted = 0.5 * (priced(even.modes, v[2]) + priced(odd.modes, v[1]));
-  } else if (cross) {
-    cross_fitted = total(PixelMode::PathTrace);
+    mix.halves = 0.5 * (even.variance + odd.variance);
+    mix.cross_fitted = 0.5 * (priced(even.modes, v[2]) + priced(odd.modes, v[1]));
+    mix.estimate += std::max(0.0, mix.cross_fitted - mix.halves) / std::sqrt(2.0);
   }
   std::array<Score, kVariants> scores{};
-  scores[kMixed] = {mixed.missing, cross_fitted * mixed.cost};
+  scores[kMixed] = {mixed.missing, mix.estimate * mixed.cost};
   if (path_tracing) return scores;  // every pixel path traces: no other option
-  const auto count_missing = [&](PixelMode m) {
-    double missing = 0;
-    for (double x : *v[0].of(m)) missing += std::isfinite(x) ? 0.0 : 1.0;
-    return missing;
-  };
   const std::array<double, kVariants> pixel_costs{0, price.core, price.core + price.merge_extra,
                                                   price.stopped};
   for (size_t k = kAllCore; k < kVariants; ++k) {
-    const PixelMode m = kVariantModes[k];
-    if (!v[0].of(m)) continue;
-    scores[k] = {count_missing(m), total(m) * pixel_costs[k] * double(n)};
+    const std::vector<double>* variances = v[0].of(kVariantModes[k]);
+    if (!variances) continue;
+    double missing = 0;
+    for (double x : *variances) missing += std::isfinite(x) ? 0.0 : 1.0;
+    const double total = finite_sum(n, [&](size_t p) { return (*variances)[p]; });
+    scores[k] = {missing, total * pixel_costs[k] * double(n)};
   }
   return scores;
 }
-
 }  // namespace
 
 void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double iterations,
@@ -434,9 +438,9 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     PixelChoice choice =
         j == 0 ? choose_pixel_modes(pt[0], pt[0], pt[0], nullptr, price, true)
                : choose_pixel_modes(v[0].no_merge, v[0].merge, pt[0], v[0].stops, price, false);
-    double cross_fitted = 0;
+    MixPrice mix;
     const std::array<Score, kVariants> scores =
-        variant_scores(grid_pixels_, v, choice, price, cross, j == 0, cross_fitted);
+        variant_scores(grid_pixels_, v, choice, price, cross, j == 0, mix);
     size_t variant = kMixed;
     for (size_t k = kAllCore; k < kVariants; ++k) {
       const Score needed{scores[variant].missing, scores[variant].value / kMixMargin};
@@ -452,7 +456,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
         variant == kMixed ? choice : uniform_choice(v[0], kVariantModes[variant], pixel_cost);
     table.push_back(candidate_row(c, option, choice, price, v[0].stops != nullptr, pixels,
                                   roulette_[j], roulette_[j == 0 ? j : j + 1], scores, variant,
-                                  cross_fitted));
+                                  mix));
     // A forced mode other than path tracing needs light paths (force_mode_).
     const bool excluded = j == 0 && force_mode_ >= 0 && force_mode_ != int(PixelMode::PathTrace);
     if (scores[variant] < best && !excluded) {

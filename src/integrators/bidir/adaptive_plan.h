@@ -22,9 +22,13 @@
 // either measured in the probes on this machine (non-deterministic, used with --time) or the
 // fixed model below (deterministic). The choice minimises sum_p relVar_p x cost: for each global
 // (light paths, connections) each pixel takes the mode of lowest variance x (pixel cost), path
-// tracing only where its variance is within a margin of the core's; then the global pair wins
-// that misses energy (infinite variance: paths none of its techniques make) in the fewest pixels,
-// and among those has the lowest total.
+// tracing only where its variance is within a margin of the core's; that mix competes with every
+// pixel in one mode (the core, the core and merging, photon mapping). The minimum per pixel over
+// noisy estimates is biased low, so the mix is priced cross-fitted: the modes that the even
+// probes choose are priced on the odd probes' variances and vice versa, and every option of
+// every pair is scored from the two halves alike. Then the global pair wins that misses energy
+// (infinite variance: paths none of its techniques make) in the fewest pixels, and among those
+// has the lowest total.
 //
 // Probes are iterations 0 and 1, then each once the iterations since the last one have cost
 // (predicted by the fixed model) what everything before it did, so their cost fades as the

@@ -38,7 +38,8 @@ def row(out, name):
         run = next(r for r in results["runs"] if r["integrator"] == "adaptive-vcm")
         last = run["stats"]["adaptive"]["history"][-1]
         chose = (f"{last['light_path_factor']:g}, {last['connections']}, "
-                 f"{100 * last['merge_fraction']:.0f}%, {100 * last['path_trace_fraction']:.0f}%")
+                 f"{100 * last['merge_fraction']:.0f}%, {100 * last['path_trace_fraction']:.0f}%, "
+                 f"{100 * last.get('stop_fraction', 0):.0f}%")
     its = f"{iterations.get('vcm', '')} / {iterations.get('adaptive-vcm', '')}"
     return f"| {name} | " + " | ".join(cells + [vs, chose, its]) + " |"
 
@@ -46,7 +47,7 @@ def row(out, name):
 def main():
     out, names = sys.argv[1], sys.argv[2:]
     print("| scene | `pt` | `bpt` | `ppm` | `vcm` | `adaptive-vcm` | vs best (relMSE / trimmed) "
-          "| chose (light paths / pixel, connections, merging, path tracing) "
+          "| chose (light paths / pixel, connections, merging, path tracing, photon mapping) "
           "| iterations (`vcm` / `adaptive-vcm`) |")
     print("|---|---|---|---|---|---|---|---|---|")
     for name in names:

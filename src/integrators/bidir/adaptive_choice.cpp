@@ -163,23 +163,52 @@ double finite_sum(size_t n, Fn&& value) {
   return total;
 }
 
-// Every pixel in mode m (the candidate's pure options beside its per-pixel mix).
-PixelChoice uniform_choice(const PairVariances& v, PixelMode m, double pixel_cost) {
-  PixelChoice out;
-  out.variances = *v.of(m);
-  out.modes.assign(out.variances.size(), m);
-  out.variance = finite_sum(out.variances.size(), [&](size_t p) { return out.variances[p]; });
-  for (double x : out.variances) out.missing += std::isfinite(x) ? 0.0 : 1.0;
-  out.cost = pixel_cost * double(out.variances.size());
-  return out;
-}
-
 // A candidate's options: its per-pixel mix of modes, or every pixel in one mode.
 enum Variant : size_t { kMixed, kAllCore, kAllMerge, kAllStop, kVariants };
 constexpr std::array<const char*, kVariants> kVariantNames{"mixed", "bidirectional", "merge",
                                                            "photon_mapping"};
 constexpr std::array<PixelMode, kVariants> kVariantModes{
     PixelMode::Bidirectional, PixelMode::Bidirectional, PixelMode::Merge, PixelMode::Stop};
+
+// The photon-mapping candidate of a light-path factor: its index after kCoreCandidates
+// (kStopCandidates: none).
+size_t stop_index_of(float factor) {
+  const std::vector<AdaptivePlan::Candidate>& list = AdaptivePlan::candidates();
+  for (size_t i = 0; i < AdaptivePlan::kStopCandidates; ++i)
+    if (list[AdaptivePlan::kCoreCandidates + i].light_path_factor == factor) return i;
+  return AdaptivePlan::kStopCandidates;
+}
+
+// What a pixel costs per iteration under a one-mode option.
+double variant_pixel_cost(size_t variant, const ModePrices& price) {
+  return variant == kAllCore    ? price.core
+         : variant == kAllMerge ? price.core + price.merge_extra
+                                : price.stopped;
+}
+
+// Every pixel in the one mode of `variant` (the candidate's options beside its per-pixel mix).
+PixelChoice uniform_choice(const PairVariances& v, size_t variant, const ModePrices& price) {
+  PixelChoice out;
+  out.variances = *v.of(kVariantModes[variant]);
+  out.modes.assign(out.variances.size(), kVariantModes[variant]);
+  out.variance = finite_sum(out.variances.size(), [&](size_t p) { return out.variances[p]; });
+  for (double x : out.variances) out.missing += std::isfinite(x) ? 0.0 : 1.0;
+  out.cost = variant_pixel_cost(variant, price) * double(out.variances.size());
+  return out;
+}
+
+// The option a candidate takes: the best scored, a one-mode option only if it beats the mix by
+// kMixMargin; with a forced mode (force_mode >= 0, experiments and tests), that mode everywhere.
+size_t pick_variant(const std::array<Score, kVariants>& scores, int force_mode) {
+  size_t variant = kMixed;
+  for (size_t k = kAllCore; k < kVariants; ++k) {
+    const Score needed{scores[variant].missing, scores[variant].value / kMixMargin};
+    if (scores[k] < (variant == kMixed ? needed : scores[variant])) variant = k;
+  }
+  for (size_t k = kAllCore; k < kVariants; ++k)
+    if (force_mode == int(kVariantModes[k])) variant = k;
+  return variant;
+}
 
 // How a candidate's per-pixel mix is priced: its modes chosen and priced on every probe
 // (in_sample), each half's modes priced on that half (halves) and on the other half
@@ -224,6 +253,7 @@ nlohmann::json candidate_row(const AdaptivePlan::Candidate& c, const PixelChoice
           {"score_all_stop", score_of(kAllStop)},
           {"score", scores[variant].value}};
 }
+
 // A candidate's options scored (relative variance x time; the pixels where each misses energy)
 // from v: every probe's variances, then the even and the odd probes' (when cross). mixed: its
 // per-pixel mix from every probe.
@@ -259,15 +289,13 @@ std::array<Score, kVariants> variant_scores(size_t n, const std::array<PairVaria
   std::array<Score, kVariants> scores{};
   scores[kMixed] = {mixed.missing, mix.estimate * mixed.cost};
   if (path_tracing) return scores;  // every pixel path traces: no other option
-  const std::array<double, kVariants> pixel_costs{0, price.core, price.core + price.merge_extra,
-                                                  price.stopped};
   for (size_t k = kAllCore; k < kVariants; ++k) {
     const std::vector<double>* variances = v[0].of(kVariantModes[k]);
     if (!variances) continue;
     double missing = 0;
     for (double x : *variances) missing += std::isfinite(x) ? 0.0 : 1.0;
     const double total = finite_sum(n, [&](size_t p) { return (*variances)[p]; });
-    scores[k] = {missing, total * pixel_costs[k] * double(n)};
+    scores[k] = {missing, total * variant_pixel_cost(k, price) * double(n)};
   }
   return scores;
 }
@@ -408,11 +436,6 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     for (size_t i = 0; i < kStopCandidates; ++i)
       stop[h][i] = relative_variances(kCoreCandidates + i, means, correction[h], halves[h]);
   }
-  auto stop_index = [&](float factor) {
-    for (size_t i = 0; i < kStopCandidates; ++i)
-      if (list[kCoreCandidates + i].light_path_factor == factor) return i;
-    return kStopCandidates;
-  };
   // Path tracing is the default only among equals (kPathTracingMargin).
   Score best, path_tracing;
   size_t best_j = 0, best_variant = kMixed;
@@ -423,7 +446,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   // Candidates come in (no merge, merge) pairs after path tracing at index 0.
   for (size_t j = 0; j < kCoreCandidates; j += (j == 0 ? 1 : 2)) {
     const Candidate& c = list[j];
-    const size_t si = j == 0 ? kStopCandidates : stop_index(c.light_path_factor);
+    const size_t si = j == 0 ? kStopCandidates : stop_index_of(c.light_path_factor);
     std::array<PairVariances, 3> v;
     for (size_t h = 0; h < sets; ++h) {
       v[h].pt = &pt[h];
@@ -441,19 +464,8 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     MixPrice mix;
     const std::array<Score, kVariants> scores =
         variant_scores(grid_pixels_, v, choice, price, cross, j == 0, mix);
-    size_t variant = kMixed;
-    for (size_t k = kAllCore; k < kVariants; ++k) {
-      const Score needed{scores[variant].missing, scores[variant].value / kMixMargin};
-      if (scores[k] < (variant == kMixed ? needed : scores[variant])) variant = k;
-    }
-    // A forced mode (force_mode_) scores the candidates by that mode everywhere.
-    for (size_t k = kAllCore; k < kVariants && j > 0; ++k)
-      if (force_mode_ == int(kVariantModes[k])) variant = k;
-    const double pixel_cost = variant == kAllCore    ? price.core
-                              : variant == kAllMerge ? price.core + price.merge_extra
-                                                     : price.stopped;
-    PixelChoice option =
-        variant == kMixed ? choice : uniform_choice(v[0], kVariantModes[variant], pixel_cost);
+    const size_t variant = pick_variant(scores, j == 0 ? -1 : force_mode_);
+    PixelChoice option = variant == kMixed ? choice : uniform_choice(v[0], variant, price);
     table.push_back(candidate_row(c, option, choice, price, v[0].stops != nullptr, pixels,
                                   roulette_[j], roulette_[j == 0 ? j : j + 1], scores, variant,
                                   mix));
@@ -482,17 +494,21 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   chosen_variance_ = std::move(best_choice.variances);
   chosen_cost_ = best_choice.cost / pixels;
   predict_probe_cost(pw, t);
-  const Candidate& c = list[best_j];
+  record_choice(kVariantNames[best_variant], t, std::move(table));
+}
+
+void AdaptivePlan::record_choice(const char* variant, const CostModel& t, nlohmann::json table) {
+  const Candidate& c = candidates()[chosen_j_];
   history_.push_back({{"after_probe", probes_},
                       {"predicted_probe_us_per_pixel", probe_cost_},
                       {"light_path_factor", c.light_path_factor},
                       {"connections", c.connections},
-                      {"variant", kVariantNames[best_variant]},
+                      {"variant", variant},
                       {"merge_fraction", fraction_of(modes_, PixelMode::Merge)},
                       {"path_trace_fraction", fraction_of(modes_, PixelMode::PathTrace)},
                       {"stop_fraction", fraction_of(modes_, PixelMode::Stop)},
                       {"costs_us", to_json(t)},
-                      {"candidates", table}});
+                      {"candidates", std::move(table)}});
 }
 
 void AdaptivePlan::take_choice(size_t j, const std::vector<PixelMode>& grid_modes) {

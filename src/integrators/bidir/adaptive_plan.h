@@ -261,6 +261,8 @@ class AdaptivePlan {
                                          Half half = Half::All) const;
   // Scores every candidate from the probes so far and takes the best (adaptive_choice.cpp).
   void choose(const std::vector<float>& means);
+  // Adds the choice just taken to the history: its option (variant), costs and candidate table.
+  void record_choice(const char* variant, const CostModel& t, nlohmann::json table);
   // Takes candidate j with one mode per grid pixel (chosen_, modes_, chosen_j_).
   void take_choice(size_t j, const std::vector<PixelMode>& grid_modes);
   // A probe's predicted microseconds per pixel after a choice (probe_cost_).

@@ -290,12 +290,9 @@ std::array<Score, kVariants> variant_scores(size_t n, const std::array<PairVaria
   scores[kMixed] = {mixed.missing, mix.estimate * mixed.cost};
   if (path_tracing) return scores;  // every pixel path traces: no other option
   for (size_t k = kAllCore; k < kVariants; ++k) {
-    const std::vector<double>* variances = v[0].of(kVariantModes[k]);
-    if (!variances) continue;
-    double missing = 0;
-    for (double x : *variances) missing += std::isfinite(x) ? 0.0 : 1.0;
-    const double total = finite_sum(n, [&](size_t p) { return (*variances)[p]; });
-    scores[k] = {missing, total * variant_pixel_cost(k, price) * double(n)};
+    if (!v[0].of(kVariantModes[k])) continue;
+    const PixelChoice all = uniform_choice(v[0], k, price);
+    scores[k] = {all.missing, all.variance * all.cost};
   }
   return scores;
 }

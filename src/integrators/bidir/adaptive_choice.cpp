@@ -1,6 +1,6 @@
 // Choosing adaptive-vcm's configuration from the probes (AdaptivePlan::choose): every
-// candidate's per-pixel relative variance from the recorded second moments, each pixel's mode of
-// lowest variance x cost, the candidate of lowest total, and the check of the last choice against
+// candidate's per-pixel relative variance from the recorded second moments, its per-pixel modes
+// (pixel_modes.h), the candidate of lowest total, and the check of the last choice against
 // what rendering it showed (adaptive_plan.h).
 #include <tbb/parallel_for.h>
 
@@ -14,6 +14,7 @@
 #include "integrators/bidir/adaptive_costs.h"
 #include "integrators/bidir/adaptive_plan.h"
 #include "integrators/bidir/grid_statistics.h"
+#include "integrators/bidir/pixel_modes.h"
 
 namespace caustica::bidir {
 
@@ -27,100 +28,12 @@ constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relat
 // a quarter of the light paths won by 0.25% of the score while `pt` was 1.09x (20 s) and 1.15x
 // (60 s) better. The margin changes no choice where a configuration is predicted 5% better.
 constexpr double kPathTracingMargin = 1.05;
-// A pixel path traces alone only where its predicted variance is at most this much above the
-// core's: the prediction is that of path tracing under the balance heuristic (the candidate
-// without light paths) while pt's estimator uses the power heuristic, and a pixel's rare bright
-// paths are the least predictable part. 20 s, 1 thread, seeds 0 / 1, relMSE: veach-mis without
-// the bound 0.000696 / 0.000692, with 1.0 0.000620 / 0.000584, with 1.1 0.000684 / 0.000643
-// (before pixels could path trace: 0.000666 / 0.000622); sun-glass 0.000339 / 0.000324,
-// 0.000586 / 0.000420, 0.000362 / 0.000320; material-spheres 0.000257 / 0.000278, 0.000264 /
-// 0.000276, 0.000253 / 0.000257.
-constexpr double kPathTracingPixelMargin = 1.1;
 // A candidate renders every pixel in one mode instead of its per-pixel mix only where that is
 // predicted better by more than this factor: the mix is priced with the modes that half of the
 // probes chose (cross-fitted, variant_scores), worse than those that all of them choose, so the
 // price is high by that. On cornell-glass at 48 x 48 the mix (4% of the pixels merging at the
 // caustic) and the core everywhere were priced within 0.1% of each other.
 constexpr double kMixMargin = 1.05;
-
-// One candidate's decision per pixel, and its sums over the pixels.
-struct PixelChoice {
-  std::vector<PixelMode> modes;
-  std::vector<double> variances;  // of the mode each pixel took
-  double variance = 0;            // the finite ones'
-  double cost = 0;                // microseconds per iteration
-  double missing = 0;             // pixels of infinite variance
-  double variance_no_merge = 0, variance_all_merge = 0, variance_all_stop = 0;
-};
-
-// What a pixel costs per iteration in each mode under one candidate.
-struct ModePrices {
-  double core = 0, merge_extra = 0, path_traced = 0, stopped = 0;
-};
-
-// Per pixel, the option of lowest variance x cost: path tracing alone (where it is as good as the
-// light paths' techniques, it is cheaper: a caustic that only light paths make need not make
-// every pixel pay for the bidirectional core), the core, or the core and merging; photon mapping
-// alone where it beats the core (ppm's estimator: a caustic seen on a diffuse surface needs no
-// connections or light tracing there). stops: photon mapping's variances (none: not an option);
-// path_tracing_only: the candidate without light paths.
-PixelChoice choose_pixel_modes(const std::vector<double>& no_merge,
-                               const std::vector<double>& merge, const std::vector<double>& pt,
-                               const std::vector<double>* stops, const ModePrices& price,
-                               bool path_tracing_only) {
-  const size_t n = pt.size();
-  PixelChoice out;
-  out.modes.resize(n);
-  out.variances.resize(n);
-  // Per block of pixels: finite variance, cost, variance without and with merging and with
-  // photon mapping everywhere, pixels of infinite variance.
-  std::vector<std::array<double, 6>> blocks((n + kPixelBlock - 1) / kPixelBlock);
-  for_pixel_blocks(n, [&](size_t b, size_t begin, size_t end) {
-    std::array<double, 6> sum{};
-    for (size_t p = begin; p < end; ++p) {
-      const double v0 = no_merge[p], v1 = merge[p], vt = pt[p];
-      const double vs = stops ? (*stops)[p] : std::numeric_limits<double>::infinity();
-      sum[2] += v0;
-      sum[3] += v1;
-      sum[5] += vs;
-      // The core, with merging where that is better; path tracing where it beats both.
-      double v = v0, pixel_cost = price.core;
-      out.modes[p] = PixelMode::Bidirectional;
-      if (v1 * (price.core + price.merge_extra) < v0 * price.core) {
-        v = v1;
-        pixel_cost = price.core + price.merge_extra;
-        out.modes[p] = PixelMode::Merge;
-      }
-      if (vs * price.stopped < v * pixel_cost) {
-        v = vs;
-        pixel_cost = price.stopped;
-        out.modes[p] = PixelMode::Stop;
-      }
-      if (path_tracing_only || (vt * price.path_traced <= v * pixel_cost && std::isfinite(vt) &&
-                                vt <= kPathTracingPixelMargin * std::min(v0, v1))) {
-        v = vt;
-        pixel_cost = price.path_traced;
-        out.modes[p] = PixelMode::PathTrace;
-      }
-      out.variances[p] = v;
-      if (std::isfinite(v))
-        sum[0] += v;
-      else
-        sum[4] += 1;
-      sum[1] += pixel_cost;
-    }
-    blocks[b] = sum;
-  });
-  for (const std::array<double, 6>& sum : blocks) {
-    out.variance += sum[0];
-    out.cost += sum[1];
-    out.variance_no_merge += sum[2];
-    out.variance_all_merge += sum[3];
-    out.missing += sum[4];
-    out.variance_all_stop += sum[5];
-  }
-  return out;
-}
 
 // Candidates compare by the pixels where their variance is infinite (energy they would miss:
 // paths none of their techniques there can make), then by score (relative variance x time).
@@ -279,9 +192,9 @@ std::array<Score, kVariants> variant_scores(size_t n, const std::array<PairVaria
       });
     };
     const PixelChoice even =
-        choose_pixel_modes(v[1].no_merge, v[1].merge, *v[1].pt, v[1].stops, price, false);
+        choose_modes(v[1].no_merge, v[1].merge, *v[1].pt, v[1].stops, price, false);
     const PixelChoice odd =
-        choose_pixel_modes(v[2].no_merge, v[2].merge, *v[2].pt, v[2].stops, price, false);
+        choose_modes(v[2].no_merge, v[2].merge, *v[2].pt, v[2].stops, price, false);
     mix.halves = 0.5 * (even.variance + odd.variance);
     mix.cross_fitted = 0.5 * (priced(even.modes, v[2]) + priced(odd.modes, v[1]));
     mix.estimate += std::max(0.0, mix.cross_fitted - mix.halves) / std::sqrt(2.0);
@@ -456,8 +369,8 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
                            path_tracing_cost(c, pw, t),
                            v[0].stops ? stop_cost(list[kCoreCandidates + si], pw, t) : 0.0};
     PixelChoice choice =
-        j == 0 ? choose_pixel_modes(pt[0], pt[0], pt[0], nullptr, price, true)
-               : choose_pixel_modes(v[0].no_merge, v[0].merge, pt[0], v[0].stops, price, false);
+        j == 0 ? choose_modes(pt[0], pt[0], pt[0], nullptr, price, true)
+               : choose_modes(v[0].no_merge, v[0].merge, pt[0], v[0].stops, price, false);
     MixPrice mix;
     const std::array<Score, kVariants> scores =
         variant_scores(grid_pixels_, v, choice, price, cross, j == 0, mix);

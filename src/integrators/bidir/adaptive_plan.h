@@ -21,7 +21,8 @@
 // vertices, light vertices, connections, merge queries and photons) times per-operation costs,
 // either measured in the probes on this machine (non-deterministic, used with --time) or the
 // fixed model below (deterministic). The choice minimises sum_p relVar_p x cost: for each global
-// (light paths, connections) each pixel takes the mode of lowest variance x (pixel cost), path
+// (light paths, connections) the pixels take the modes of lowest total variance x total cost
+// (pixel_modes.h: per pixel the lowest v / V + c / C at the image's means V and C), path
 // tracing only where its variance is within a margin of the core's; that mix competes with every
 // pixel in one mode (the core, the core and merging, photon mapping). The minimum per pixel over
 // noisy estimates is biased low, so the mix is priced cross-fitted: the modes that the even

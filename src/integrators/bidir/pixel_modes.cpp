@@ -86,16 +86,18 @@ PixelChoice choose_modes(const std::vector<double>& no_merge, const std::vector<
                          const ModePrices& price, bool path_tracing_only) {
   PixelChoice best = choose_pixel_modes(no_merge, merge, pt, stops, price, path_tracing_only);
   if (path_tracing_only) return best;
-  PixelChoice last = best;
+  const double n = double(pt.size());
+  double missing = best.missing, variance = best.variance, cost = best.cost;  // the last pass's
   for (int pass = 0; pass < kLagrangePasses; ++pass) {
-    const double n = double(pt.size()), finite = n - last.missing;
-    if (!(finite > 0) || !(last.variance > 0) || !(last.cost > 0)) break;
-    const ModeScore score{finite / last.variance, n / last.cost};
-    PixelChoice next = choose_pixel_modes(no_merge, merge, pt, stops, price, false, score);
-    if (next.missing < best.missing ||
-        (next.missing == best.missing && next.variance * next.cost < best.variance * best.cost))
-      best = next;
-    last = std::move(next);
+    if (!(n > missing) || !(variance > 0) || !(cost > 0)) break;
+    PixelChoice next = choose_pixel_modes(no_merge, merge, pt, stops, price, false,
+                                          ModeScore{(n - missing) / variance, n / cost});
+    missing = next.missing;
+    variance = next.variance;
+    cost = next.cost;
+    if (missing < best.missing ||
+        (missing == best.missing && variance * cost < best.variance * best.cost))
+      best = std::move(next);
   }
   return best;
 }

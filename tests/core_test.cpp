@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -94,6 +95,39 @@ TEST(Distribution1D, DiscreteSamplingFollowsWeights) {
   EXPECT_EQ(counts[1], 0);
   EXPECT_NEAR(counts[0] / 80000.0, 0.125, 0.006);
   EXPECT_NEAR(counts[3] / 80000.0, 0.5, 0.01);
+}
+
+// The guide table only narrows the search: every u must pick the index a search of the whole
+// cdf picks (the largest i with cdf[i] <= u, clamped to the last bucket, then past empty
+// buckets), bucket edges and their float neighbours included.
+TEST(Distribution1D, GuidedSearchPicksWhatAFullSearchPicks) {
+  Pcg32 r(17, 3);
+  for (int trial = 0; trial < 60; ++trial) {
+    const size_t n = 1 + r.next_u32() % (trial < 30 ? 40u : 5000u);
+    std::vector<float> w(n);
+    for (size_t i = 0; i < n; ++i) {
+      const float x = r.next_float();
+      w[i] = x < 0.3f ? 0.f : x < 0.35f ? 1e4f * x : x;  // runs of zeros, a few spikes
+    }
+    const Distribution1D d(w);
+    const std::vector<float>& cdf = d.cdf();
+    std::vector<float> us = {0.f, 0.5f, kOneMinusEpsilon};
+    for (int i = 0; i < 400; ++i) us.push_back(r.next_float());
+    for (float c : cdf)
+      for (float u : {c, std::nextafter(c, 0.f), std::nextafter(c, 2.f)})
+        if (u >= 0 && u < 1) us.push_back(u);
+    for (float u : us) {
+      size_t want = size_t(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()) - 1;
+      want = std::min(want, n - 1);
+      while (d.pmf(want) == 0 && want + 1 < n) ++want;
+      float pmf;
+      ASSERT_EQ(d.sample_discrete(u, &pmf), want) << "n " << n << " u " << u;
+      size_t offset = 0;
+      float pdf;
+      d.sample_continuous(u, &pdf, &offset);
+      ASSERT_EQ(offset, want);
+    }
+  }
 }
 
 TEST(Distribution2D, PdfMatchesSampleAndIntegratesToOne) {

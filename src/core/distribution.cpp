@@ -6,6 +6,32 @@
 
 namespace caustica {
 
+// Largest i in [lo, lo + len) with cdf[i] <= u, given cdf[lo] <= u (or lo = 0). A binary
+// search whose steps are selects, not branches: no mispredicted branch per halving.
+static size_t search_range(const float* cdf, size_t lo, size_t len, float u) {
+  while (len > 1) {
+    const size_t half = len / 2;
+    lo = cdf[lo + half] <= u ? lo + half : lo;
+    len -= half;
+  }
+  return lo;
+}
+
+static std::vector<uint32_t> build_guide(const std::vector<float>& cdf) {
+  const size_t n = cdf.size() - 1;
+  size_t steps = 1;
+  while (steps * 4 < n && steps < (size_t(1) << 22)) steps *= 2;
+  std::vector<uint32_t> guide(steps + 1);
+  size_t i = 0;
+  for (size_t k = 0; k <= steps; ++k) {
+    // k / steps is exact in float (steps is a power of two), as u * steps is at lookup.
+    const float t = float(k) / float(steps);
+    while (i + 1 <= n && cdf[i + 1] <= t) ++i;
+    guide[k] = uint32_t(i);
+  }
+  return guide;
+}
+
 Distribution1D::Distribution1D(std::vector<float> weights) : func_(std::move(weights)) {
   if (func_.empty()) throw std::invalid_argument("Distribution1D needs at least one weight");
   for (float& f : func_)
@@ -22,28 +48,30 @@ Distribution1D::Distribution1D(std::vector<float> weights) : func_(std::move(wei
     std::fill(func_.begin(), func_.end(), 1.f);
     for (size_t i = 0; i <= n; ++i) cdf_[i] = float(i) / float(n);
     integral_ = 1;
+    guide_ = build_guide(cdf_);
     return;
   }
   integral_ = float(acc / double(n));
   for (size_t i = 1; i <= n; ++i) cdf_[i] = float(cdf_[i] / acc);
   cdf_[n] = 1;
+  guide_ = build_guide(cdf_);
 }
 
-static size_t find_interval(const std::vector<float>& cdf, float u) {
-  // Largest i with cdf[i] <= u, clamped to [0, n-1] (cdf[0] = 0). A binary search whose steps
-  // are selects, not branches: the same index as std::upper_bound minus one for any u >= 0,
-  // without a mispredicted branch per halving (it runs for every camera ray's filter sample).
-  size_t lo = 0, len = cdf.size();
-  while (len > 1) {
-    const size_t half = len / 2;
-    lo = cdf[lo + half] <= u ? lo + half : lo;
-    len -= half;
-  }
-  return std::min(lo, cdf.size() - 2);
+size_t Distribution1D::find_interval(float u) const {
+  // Clamped to [0, n-1] (cdf[0] = 0); the same index as std::upper_bound minus one for u >= 0.
+  const size_t n = func_.size();
+  if (!(u >= 0)) return 0;
+  const size_t steps = guide_.size() - 1;
+  const float scaled = u * float(steps);  // exact: steps is a power of two
+  const size_t k = scaled < float(steps) ? size_t(scaled) : steps - 1;
+  // k / steps <= u < (k + 1) / steps (or k is the last step), so the answer lies in
+  // [guide_[k], guide_[k + 1]].
+  const size_t lo = guide_[k], hi = guide_[k + 1];
+  return std::min(search_range(cdf_.data(), lo, hi - lo + 1, u), n - 1);
 }
 
 size_t Distribution1D::sample_discrete(float u, float* pmf_out, float* remapped) const {
-  size_t i = find_interval(cdf_, u);
+  size_t i = find_interval(u);
   while (func_[i] == 0 && i + 1 < func_.size()) ++i;  // guard against u landing on a flat step
   if (pmf_out) *pmf_out = pmf(i);
   if (remapped) {
@@ -59,7 +87,7 @@ float Distribution1D::pmf(size_t i) const {
 }
 
 float Distribution1D::sample_continuous(float u, float* pdf, size_t* offset) const {
-  size_t i = find_interval(cdf_, u);
+  size_t i = find_interval(u);
   while (func_[i] == 0 && i + 1 < func_.size()) ++i;
   if (offset) *offset = i;
   float du = u - cdf_[i];

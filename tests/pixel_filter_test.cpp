@@ -248,6 +248,33 @@ TEST(PixelFilter, PdfTimesWeightIsTheNormalisedFilter) {
   }
 }
 
+// A light-tracing connection is skipped where no candidate pixel takes splats
+// (BidirIntegrator::splat_can_land): every pixel whose support holds the raster point must be a
+// candidate, also at pixel edges, at the film's border and outside it.
+TEST(PixelFilter, CandidatePixelsHoldEveryPixelWhoseSupportHoldsTheRasterPoint) {
+  const int w = 9, h = 7;
+  for (const PixelFilterParams& p : all_filters()) {
+    const PixelFilter filter(p);
+    Pcg32 rng(11, 12);
+    int missed = 0, splats = 0;
+    for (int i = 0; i < 4000; ++i) {
+      Vec2 raster{-1.5f + 12.f * rng.next_float(), -1.5f + 10.f * rng.next_float()};
+      if (i % 4 == 0) raster.x = std::round(raster.x);  // on pixel edges
+      if (i % 4 == 1) raster = {raster.x, std::nextafter(std::round(raster.y), 0.f)};
+      const PixelFilter::PixelRange range = filter.candidate_pixels(raster, w, h);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const Vec2 offset{raster.x - (float(x) + 0.5f), raster.y - (float(y) + 0.5f)};
+          if (!(filter.at(offset).pdf > 0)) continue;
+          ++splats;
+          missed += x < range.x0 || x > range.x1 || y < range.y0 || y > range.y1;
+        }
+    }
+    EXPECT_EQ(missed, 0) << describe(p);
+    EXPECT_GT(splats, 1000) << describe(p);
+  }
+}
+
 TEST(PixelFilter, BoxOfHalfAPixelIsTheUniformJitterBitForBit) {
   const PixelFilter box;  // the default: box, radius 1/2
   Pcg32 rng(1, 2);

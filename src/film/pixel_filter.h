@@ -72,6 +72,21 @@ class PixelFilter {
   template <typename Fn>
   void for_each_pixel(Vec2 raster, int width, int height, Fn&& fn) const;
 
+  // The pixels for_each_pixel considers for `raster`, [x0, x1] x [y0, y1] (empty when x0 > x1
+  // or y0 > y1): every pixel whose support holds raster is among them (the range is one pixel
+  // wider than the support against rounding).
+  struct PixelRange {
+    int x0, x1, y0, y1;
+  };
+  PixelRange candidate_pixels(Vec2 raster, int width, int height) const {
+    // Pixel x's support holds raster.x iff -r <= raster.x - (x + 1/2) < r.
+    const Vec2 r = radius();
+    return {std::max(0, int(std::floor(raster.x - 0.5f - r.x))),
+            std::min(width - 1, int(std::floor(raster.x - 0.5f + r.x)) + 1),
+            std::max(0, int(std::floor(raster.y - 0.5f - r.y))),
+            std::min(height - 1, int(std::floor(raster.y - 0.5f + r.y)) + 1)};
+  }
+
  private:
   // One axis: f_x, its integral, and its sampling (exact or tabulated).
   struct Axis {
@@ -97,13 +112,8 @@ class PixelFilter {
 
 template <typename Fn>
 void PixelFilter::for_each_pixel(Vec2 raster, int width, int height, Fn&& fn) const {
-  // Pixel x's support holds raster.x iff -r <= raster.x - (x + 1/2) < r; the range is one pixel
-  // wider than that against rounding, and Axis::pdf decides.
-  const Vec2 r = radius();
-  const int x0 = std::max(0, int(std::floor(raster.x - 0.5f - r.x))),
-            x1 = std::min(width - 1, int(std::floor(raster.x - 0.5f + r.x)) + 1);
-  const int y0 = std::max(0, int(std::floor(raster.y - 0.5f - r.y))),
-            y1 = std::min(height - 1, int(std::floor(raster.y - 0.5f + r.y)) + 1);
+  // Axis::pdf decides among the candidate pixels.
+  const auto [x0, x1, y0, y1] = candidate_pixels(raster, width, height);
   for (int y = y0; y <= y1; ++y) {
     FilterSample s;
     s.offset.y = raster.y - (float(y) + 0.5f);

@@ -105,6 +105,9 @@ struct IterationPlan {
     return !records(pixel) && (light_paths == 0 || (!merge_everywhere && modes &&
                                                     (*modes)[pixel] == PixelMode::PathTrace));
   }
+  // Light-tracing splats land in the pixel (a pixel that path traces or maps photons alone
+  // takes none).
+  bool takes_splats(size_t pixel) const { return !path_traces(pixel) && !stops(pixel); }
   bool any_merge() const {
     return light_paths > 0 && (merge_everywhere || probe ||
                                (modes && std::any_of(modes->begin(), modes->end(), [](PixelMode m) {

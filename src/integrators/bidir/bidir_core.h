@@ -240,6 +240,11 @@ class BidirIntegrator final : public CameraPathIntegrator {
   bool splat_lens_connection(const Camera& camera, const Iteration& it, Vec2 raster,
                              uint32_t technique, const ValueOf& value_of, const TermsOf& terms_of,
                              LightChunk& chunk) const;
+  // Whether a lens connection landing at `raster` can splat anywhere: false when every pixel
+  // whose support may hold it path traces or maps photons alone (adaptive-vcm's PixelMode;
+  // those take no splat, splat_lens_connection), so that the caller skips the BSDF, the shadow
+  // ray and the densities of a connection nobody takes. True for every other integrator.
+  bool splat_can_land(const Camera& camera, const Iteration& it, Vec2 raster) const;
   // t = 1: the light vertex seen through a lens point; splat recorded in the chunk. Returns
   // the connection's unweighted estimate (0 when blocked), what the guiding of light subpaths
   // learns from.

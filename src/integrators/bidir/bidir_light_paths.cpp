@@ -237,25 +237,34 @@ bool BidirIntegrator::splat_lens_connection(const Camera& camera, const Iteratio
                                             uint32_t technique, const ValueOf& value_of,
                                             const TermsOf& terms_of, LightChunk& chunk) const {
   const size_t first_splat = chunk.splats.size();
-  filter_.for_each_pixel(
-      raster, camera.width(), camera.height(), [&](int x, int y, const FilterSample& fs) {
-        const uint32_t pixel = uint32_t(y * camera.width() + x);
-        if (tech_.adaptive && (it.plan.path_traces(pixel) || it.plan.stops(pixel)))
-          return;  // pt's or ppm's estimator alone there
-        const MisRules& rules = it.rules_at(pixel);
-        const TechniqueTerms terms = terms_of(rules, fs.pdf);
-        const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
-        const Rgb value = value_of(w) * (fs.weight * fs.pdf);
-        if (value.is_black()) return;
-        if (!value.is_finite()) {
-          ++chunk.nonfinite;
-          return;
-        }
-        chunk.splats.push_back({pixel, technique, value});
-        // The plan prices the recorded pixels' splats (append_chunk).
-        if (it.plan.records(pixel)) chunk.splat_terms.push_back(terms);
-      });
+  filter_.for_each_pixel(raster, camera.width(), camera.height(),
+                         [&](int x, int y, const FilterSample& fs) {
+                           const uint32_t pixel = uint32_t(y * camera.width() + x);
+                           if (tech_.adaptive && !it.plan.takes_splats(pixel))
+                             return;  // pt's or ppm's estimator alone there
+                           const MisRules& rules = it.rules_at(pixel);
+                           const TechniqueTerms terms = terms_of(rules, fs.pdf);
+                           const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
+                           const Rgb value = value_of(w) * (fs.weight * fs.pdf);
+                           if (value.is_black()) return;
+                           if (!value.is_finite()) {
+                             ++chunk.nonfinite;
+                             return;
+                           }
+                           chunk.splats.push_back({pixel, technique, value});
+                           // The plan prices the recorded pixels' splats (append_chunk).
+                           if (it.plan.records(pixel)) chunk.splat_terms.push_back(terms);
+                         });
   return chunk.splats.size() > first_splat;
+}
+
+bool BidirIntegrator::splat_can_land(const Camera& camera, const Iteration& it, Vec2 raster) const {
+  if (!tech_.adaptive) return true;
+  const auto [x0, x1, y0, y1] = filter_.candidate_pixels(raster, camera.width(), camera.height());
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x)
+      if (it.plan.takes_splats(size_t(y) * size_t(camera.width()) + size_t(x))) return true;
+  return false;
 }
 
 void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Iteration& it,
@@ -266,7 +275,7 @@ void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Itera
   // A stream of its own: the light subpaths draw the numbers they drew without this technique.
   Pcg32 rng = Pcg32::for_sample(path, it.index, hash_combine(settings_.seed, 0x1e4ull));
   const auto cs = camera.sample_wi(le.p, rng.next_2d());
-  if (!cs || !(cs->importance > 0)) return;
+  if (!cs || !(cs->importance > 0) || !splat_can_land(camera, it, cs->raster)) return;
   const Rgb radiance = light.radiance(le.p, le.n, {}, cs->wi);
   if (radiance.is_black()) return;
   const float pos_pdf = pmf * le.pdf_pos;
@@ -297,6 +306,9 @@ Rgb BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
   const Camera& camera = scene.camera();
   const auto cs = camera.sample_wi(si.p, rng.next_2d());
   if (!cs || !(cs->importance > 0)) return Rgb(0.f);
+  // Before the BSDF: adaptive-vcm's vertices are unguided (q = 1 below draws no number), so
+  // skipping here leaves every random stream as it was.
+  if (!splat_can_land(camera, it, cs->raster)) return Rgb(0.f);
   const Rgb f = bsdf.f(si.wo, cs->wi, TransportMode::Importance) * bsdf.abs_cos(cs->wi);
   if (f.is_black()) return Rgb(0.f);
   // Taken with the vertex's learned probability toward the lens (technique_probabilities.h).

@@ -437,6 +437,9 @@ void AdaptivePlan::take_choice(size_t j, const std::vector<PixelMode>& grid_mode
       modes_[size_t(y) * width_ + x] = grid_modes[gy * grid_w_ + gx];
     }
   }
+  chosen_.splats_nowhere = std::none_of(modes_.begin(), modes_.end(), [](PixelMode m) {
+    return m == PixelMode::Bidirectional || m == PixelMode::Merge;
+  });
 }
 
 void AdaptivePlan::predict_probe_cost(const PixelWork& pw, const CostModel& t) {

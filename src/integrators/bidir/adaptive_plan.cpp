@@ -166,6 +166,7 @@ IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
                                uint64_t(std::llround(kSparseProbeLightPaths * double(pixels_))),
                                uint64_t(pixels_));
     p.probe = true;
+    p.splats_nowhere = false;  // the recorded pixels take them
     p.probe_stride = stride_;
     p.probe_offset = offset_;
     p.width = uint32_t(width_);

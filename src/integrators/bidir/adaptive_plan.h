@@ -77,6 +77,9 @@ struct IterationPlan {
   bool merge_everywhere = true;
   const std::vector<PixelMode>* modes = nullptr;  // per pixel, when !merge_everywhere
   bool probe = false;                             // record contributions for the planner
+  // No pixel takes light-tracing splats: every one path traces or maps photons alone (a
+  // choice's modes, never a probe), so that the light subpaths make no lens connection.
+  bool splats_nowhere = false;
   // A probe records every pixel (probe_stride 1) or, on a large image, the pixel at
   // (probe_offset, probe_offset) of each probe_stride x probe_stride block of the image
   // (width pixels wide): those render the probe's configuration (merging, probe_connections),

@@ -273,6 +273,7 @@ void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Itera
                                                  LightChunk& chunk) const {
   const Camera& camera = scene.camera();
   // A stream of its own: the light subpaths draw the numbers they drew without this technique.
+  if (it.plan.splats_nowhere) return;
   Pcg32 rng = Pcg32::for_sample(path, it.index, hash_combine(settings_.seed, 0x1e4ull));
   const auto cs = camera.sample_wi(le.p, rng.next_2d());
   if (!cs || !(cs->importance > 0) || !splat_can_land(camera, it, cs->raster)) return;
@@ -304,7 +305,9 @@ Rgb BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
                                        const MisSums& mis, int depth, Pcg32& rng,
                                        LightChunk& chunk) const {
   const Camera& camera = scene.camera();
-  const auto cs = camera.sample_wi(si.p, rng.next_2d());
+  const Vec2 u_lens = rng.next_2d();  // drawn also when skipped: the stream stays as it was
+  if (it.plan.splats_nowhere) return Rgb(0.f);
+  const auto cs = camera.sample_wi(si.p, u_lens);
   if (!cs || !(cs->importance > 0)) return Rgb(0.f);
   // Before the BSDF: adaptive-vcm's vertices are unguided (q = 1 below draws no number), so
   // skipping here leaves every random stream as it was.

@@ -21,7 +21,12 @@ CostModel costs_of(const ProbeWork& w, bool measured) {
   // Probes run the core only: pt's vertex is priced at the model's ratio to the core's.
   t.path_tracing_vertex =
       t.camera_vertex * (CostModel{}.path_tracing_vertex / CostModel{}.camera_vertex);
-  t.light_vertex = per(w.light_seconds, w.light_vertices, t.light_vertex);
+  // The probes' light passes connect to the lens where a pixel takes splats: timed together,
+  // split in the model's proportion.
+  const double light = per(w.light_seconds, w.light_vertices, t.light_vertex + t.lens_connection);
+  t.light_vertex =
+      light * (CostModel{}.light_vertex / (CostModel{}.light_vertex + CostModel{}.lens_connection));
+  t.lens_connection = light - t.light_vertex;
   // A probe's connections are half to the pixel's own light path, half to random ones, timed
   // together: split in the model's proportion.
   const double own = CostModel{}.own_connection / CostModel{}.connection;
@@ -40,13 +45,10 @@ CostModel costs_of(const ProbeWork& w, bool measured) {
 }
 
 nlohmann::json to_json(const CostModel& t) {
-  return {{"camera_vertex", t.camera_vertex},
-          {"path_tracing_vertex", t.path_tracing_vertex},
-          {"light_vertex", t.light_vertex},
-          {"connection", t.connection},
-          {"own_connection", t.own_connection},
-          {"merge_query", t.merge_query},
-          {"photon", t.photon}};
+  return {{"camera_vertex", t.camera_vertex}, {"path_tracing_vertex", t.path_tracing_vertex},
+          {"light_vertex", t.light_vertex},   {"lens_connection", t.lens_connection},
+          {"connection", t.connection},       {"own_connection", t.own_connection},
+          {"merge_query", t.merge_query},     {"photon", t.photon}};
 }
 
 PixelWork pixel_work_of(const ProbeWork& w, double probes, double pixels, int probe_connections) {
@@ -60,19 +62,22 @@ PixelWork pixel_work_of(const ProbeWork& w, double probes, double pixels, int pr
           w.stop_photons / (probes * pixels)};
 }
 
-double light_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
-  return c.light_path_factor * w.light_vertices_per_path * t.light_vertex;
+double light_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t,
+                  bool splats) {
+  return c.light_path_factor * w.light_vertices_per_path *
+         (t.light_vertex + (splats ? t.lens_connection : 0.0));
 }
 
 double path_tracing_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
-  return w.camera_vertices * t.path_tracing_vertex + light_cost(c, w, t);
+  return w.camera_vertices * t.path_tracing_vertex + light_cost(c, w, t, false);
 }
 
 double base_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
   if (c.light_path_factor == 0) return path_tracing_cost(c, w, t);
   const double connections =
       c.connections > 0 ? t.own_connection + (c.connections - 1) * t.connection : 0.0;
-  return w.camera_vertices * t.camera_vertex + light_cost(c, w, t) + w.connections * connections;
+  return w.camera_vertices * t.camera_vertex + light_cost(c, w, t, true) +
+         w.connections * connections;
 }
 
 double merge_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
@@ -81,7 +86,7 @@ double merge_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const Co
 
 double stop_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {
   return w.stop_camera_vertices * t.path_tracing_vertex + w.stop_merge_queries * query_price(c, t) +
-         w.stop_photons * c.light_path_factor * t.photon + light_cost(c, w, t);
+         w.stop_photons * c.light_path_factor * t.photon + light_cost(c, w, t, false);
 }
 
 }  // namespace caustica::bidir

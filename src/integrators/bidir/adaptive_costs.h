@@ -26,7 +26,14 @@ struct CostModel {
   // measured one (1 thread, 160 px wide, 16 spp, 2026-11-30: door-ajar 5.3, cornell-box 4.1,
   // veach-bidir 5.0, mis-plates 1.75, coffee 2.7; at 0.75 the model predicted 1.25x less).
   double path_tracing_vertex = 0.6;
-  double light_vertex = 1.1;  // trace, BSDF, store, connect to the lens
+  // A light vertex: traced, its BSDF, stored (0.66), and its connection to the lens (0.44),
+  // which only pixels that take light-tracing splats pay (a light subpath skips the lens
+  // connections no pixel takes: BidirIntegrator::splat_can_land). The fit above priced both
+  // together at 1.1; split as measured 2026-12-06 (640 x 480 and 512 x 512, 8 spp, 2 threads:
+  // the light pass per vertex of ppm, which makes no lens connection, over vcm's: door-ajar
+  // 0.68, point-room 0.62, mirror-caustic 0.57, cornell-caustics 0.41; 0.6 taken).
+  double light_vertex = 0.66;
+  double lens_connection = 0.44;
   // One light vertex connected to one camera vertex: of a light path drawn at random, and of
   // the pixel's own light path, which costs less. The fit above had one connection, the
   // pixel's own, and four: its slope is the random ones'. Measured 2026-12-04 (door-ajar
@@ -63,8 +70,10 @@ struct PixelWork {
 // camera vertex of which made `probe_connections` connections.
 PixelWork pixel_work_of(const ProbeWork& w, double probes, double pixels, int probe_connections);
 
-// A pixel's share of the light paths' cost.
-double light_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t);
+// A pixel's share of the light paths' cost; with `splats`, the lens connections of the light
+// vertices too (those a pixel that takes no splat does not cause).
+double light_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t,
+                  bool splats);
 // A pixel that path traces: pt's camera vertices, and its share of the light paths (which the
 // other pixels use).
 double path_tracing_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t);

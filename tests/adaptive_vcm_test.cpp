@@ -105,8 +105,9 @@ TEST(AdaptiveVcm, ProbesAreSpacedByTheirPredictedCost) {
       EXPECT_GE(h["next_probe"].get<int>(), spp);  // none within the budget
     }
   }
-  // Far fewer than the 10 probes at 0, 1, 3, 7, ..., 511.
-  EXPECT_LE(a["probes"].get<int>(), 6);
+  // Fewer than the 10 probes at 0, 1, 3, 7, ..., 511 (6 while a light path was priced by its
+  // vertices alone, 7 with its start priced too: a probe's light paths cost a little less here).
+  EXPECT_LE(a["probes"].get<int>(), 7);
 }
 
 // On the Cornell box with a glass sphere under a small area light, path tracing alone renders

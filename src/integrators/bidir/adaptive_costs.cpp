@@ -23,10 +23,15 @@ CostModel costs_of(const ProbeWork& w, bool measured) {
       t.camera_vertex * (CostModel{}.path_tracing_vertex / CostModel{}.camera_vertex);
   // The probes' light passes connect to the lens where a pixel takes splats: timed together,
   // split in the model's proportion.
-  const double light = per(w.light_seconds, w.light_vertices, t.light_vertex + t.lens_connection);
-  t.light_vertex =
-      light * (CostModel{}.light_vertex / (CostModel{}.light_vertex + CostModel{}.lens_connection));
-  t.lens_connection = light - t.light_vertex;
+  const CostModel fixed;
+  const double model_light = w.light_paths * fixed.light_path +
+                             w.light_vertices * (fixed.light_vertex + fixed.lens_connection);
+  if (model_light > 0 && w.light_seconds > 0) {
+    const double scale = 1e6 * w.light_seconds / model_light;
+    t.light_path *= scale;
+    t.light_vertex *= scale;
+    t.lens_connection *= scale;
+  }
   // A probe's connections are half to the pixel's own light path, half to random ones, timed
   // together: split in the model's proportion.
   const double own = CostModel{}.own_connection / CostModel{}.connection;
@@ -45,10 +50,15 @@ CostModel costs_of(const ProbeWork& w, bool measured) {
 }
 
 nlohmann::json to_json(const CostModel& t) {
-  return {{"camera_vertex", t.camera_vertex}, {"path_tracing_vertex", t.path_tracing_vertex},
-          {"light_vertex", t.light_vertex},   {"lens_connection", t.lens_connection},
-          {"connection", t.connection},       {"own_connection", t.own_connection},
-          {"merge_query", t.merge_query},     {"photon", t.photon}};
+  return {{"camera_vertex", t.camera_vertex},
+          {"path_tracing_vertex", t.path_tracing_vertex},
+          {"light_path", t.light_path},
+          {"light_vertex", t.light_vertex},
+          {"lens_connection", t.lens_connection},
+          {"connection", t.connection},
+          {"own_connection", t.own_connection},
+          {"merge_query", t.merge_query},
+          {"photon", t.photon}};
 }
 
 PixelWork pixel_work_of(const ProbeWork& w, double probes, double pixels, int probe_connections) {
@@ -64,8 +74,9 @@ PixelWork pixel_work_of(const ProbeWork& w, double probes, double pixels, int pr
 
 double light_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t,
                   bool splats) {
-  return c.light_path_factor * w.light_vertices_per_path *
-         (t.light_vertex + (splats ? t.lens_connection : 0.0));
+  return c.light_path_factor *
+         (t.light_path +
+          w.light_vertices_per_path * (t.light_vertex + (splats ? t.lens_connection : 0.0)));
 }
 
 double path_tracing_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {

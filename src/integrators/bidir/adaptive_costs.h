@@ -26,13 +26,20 @@ struct CostModel {
   // measured one (1 thread, 160 px wide, 16 spp, 2026-11-30: door-ajar 5.3, cornell-box 4.1,
   // veach-bidir 5.0, mis-plates 1.75, coffee 2.7; at 0.75 the model predicted 1.25x less).
   double path_tracing_vertex = 0.6;
-  // A light vertex: traced, its BSDF, stored (0.66), and its connection to the lens (0.44),
-  // which only pixels that take light-tracing splats pay (a light subpath skips the lens
-  // connections no pixel takes: BidirIntegrator::splat_can_land). The fit above priced both
-  // together at 1.1; split as measured 2026-12-06 (640 x 480 and 512 x 512, 8 spp, 2 threads:
-  // the light pass per vertex of ppm, which makes no lens connection, over vcm's: door-ajar
-  // 0.68, point-room 0.62, mirror-caustic 0.57, cornell-caustics 0.41; 0.6 taken).
-  double light_vertex = 0.66;
+  // A light path: its start on a light and its rays (0.35), and each vertex it stores: traced,
+  // its BSDF, stored (0.41); plus the vertex's connection to the lens (0.44), which only pixels
+  // that take light-tracing splats pay (a light subpath skips the lens connections no pixel
+  // takes: BidirIntegrator::splat_can_land). Until 2026-12-06 a light path was priced by its
+  // vertices alone (0.66 each): open scenes, whose light paths mostly leave the scene after
+  // at most one vertex, were priced at half of what their light passes took (sun-glass 0.58x,
+  // material-spheres 0.63x, mis-plates 0.59x), closed ones up to 1.5x (door-ajar). Fitted to
+  // the light passes of photon mapping everywhere (no lens connections) at 2 light paths per
+  // pixel on the 14 scenes of the equal-time table, minimising relative error (2 threads,
+  // 2026-12-06, docs/adaptive-vcm.md "A light path's price"): per path 0.345, per vertex 0.406,
+  // rms log error 0.42 against 0.79 for vertices alone; what is left is the scenes' materials
+  // and meshes (coffee and material-testball 2.1x, water-caustic 2.7x, veach-bidir 1.6x).
+  double light_path = 0.35;
+  double light_vertex = 0.41;
   double lens_connection = 0.44;
   // One light vertex connected to one camera vertex: of a light path drawn at random, and of
   // the pixel's own light path, which costs less. The fit above had one connection, the
@@ -70,8 +77,8 @@ struct PixelWork {
 // camera vertex of which made `probe_connections` connections.
 PixelWork pixel_work_of(const ProbeWork& w, double probes, double pixels, int probe_connections);
 
-// A pixel's share of the light paths' cost; with `splats`, the lens connections of the light
-// vertices too (those a pixel that takes no splat does not cause).
+// A pixel's share of the light paths' cost (their starts and vertices); with `splats`, the lens
+// connections of the light vertices too (those a pixel that takes no splat does not cause).
 double light_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t,
                   bool splats);
 // A pixel that path traces: pt's camera vertices, and its share of the light paths (which the

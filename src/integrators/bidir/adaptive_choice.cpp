@@ -451,12 +451,10 @@ void AdaptivePlan::predict_probe_cost(const PixelWork& pw, const CostModel& t) {
   const double choice_paths = double(chosen_.light_paths) / double(pixels_);
   const double probe_paths =
       stride_ > 1 ? std::clamp(choice_paths, kSparseProbeLightPaths, 1.0) : choice_paths;
-  probe_cost_ = recorded * (base_cost(probe_config, pw, t) + merge_cost(probe_config, pw, t)) *
-                    kProbeRecordingFactor +
-                (1 - recorded) *
-                    (chosen_cost_ + (probe_paths - choice_paths) *
-                                        (t.light_path + pw.light_vertices_per_path *
-                                                            (t.light_vertex + t.lens_connection)));
+  probe_cost_ =
+      recorded * (base_cost(probe_config, pw, t) + merge_cost(probe_config, pw, t)) *
+          kProbeRecordingFactor +
+      (1 - recorded) * (chosen_cost_ + (probe_paths - choice_paths) * light_path_cost(pw, t, true));
 }
 
 }  // namespace caustica::bidir

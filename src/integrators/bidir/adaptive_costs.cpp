@@ -72,11 +72,14 @@ PixelWork pixel_work_of(const ProbeWork& w, double probes, double pixels, int pr
           w.stop_photons / (probes * pixels)};
 }
 
+double light_path_cost(const PixelWork& w, const CostModel& t, bool splats) {
+  return t.light_path +
+         w.light_vertices_per_path * (t.light_vertex + (splats ? t.lens_connection : 0.0));
+}
+
 double light_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t,
                   bool splats) {
-  return c.light_path_factor *
-         (t.light_path +
-          w.light_vertices_per_path * (t.light_vertex + (splats ? t.lens_connection : 0.0)));
+  return c.light_path_factor * light_path_cost(w, t, splats);
 }
 
 double path_tracing_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t) {

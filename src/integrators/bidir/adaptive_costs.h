@@ -32,7 +32,7 @@ struct CostModel {
   // takes: BidirIntegrator::splat_can_land). Until 2026-12-06 a light path was priced by its
   // vertices alone (0.66 each): open scenes, whose light paths mostly leave the scene after
   // at most one vertex, were priced at half of what their light passes took (sun-glass 0.58x,
-  // material-spheres 0.63x, mis-plates 0.59x), closed ones up to 1.5x (door-ajar). Fitted to
+  // material-spheres 0.63x, mis-plates 0.59x), closed ones at up to 1.6x (door-ajar). Fitted to
   // the light passes of photon mapping everywhere (no lens connections) at 2 light paths per
   // pixel on the 14 scenes of the equal-time table, minimising relative error (2 threads,
   // 2026-12-06, docs/adaptive-vcm.md "A light path's price"): per path 0.345, per vertex 0.406,
@@ -77,8 +77,11 @@ struct PixelWork {
 // camera vertex of which made `probe_connections` connections.
 PixelWork pixel_work_of(const ProbeWork& w, double probes, double pixels, int probe_connections);
 
-// A pixel's share of the light paths' cost (their starts and vertices); with `splats`, the lens
-// connections of the light vertices too (those a pixel that takes no splat does not cause).
+// One light path's cost (its start and its vertices); with `splats`, the lens connections of its
+// vertices too (those a pixel that takes no splat does not cause).
+double light_path_cost(const PixelWork& w, const CostModel& t, bool splats);
+// A pixel's share of the light paths' cost: the candidate's light paths per pixel at
+// light_path_cost.
 double light_cost(const AdaptivePlan::Candidate& c, const PixelWork& w, const CostModel& t,
                   bool splats);
 // A pixel that path traces: pt's camera vertices, and its share of the light paths (which the

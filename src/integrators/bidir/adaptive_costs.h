@@ -33,11 +33,12 @@ struct CostModel {
   // vertices alone (0.66 each): open scenes, whose light paths mostly leave the scene after
   // at most one vertex, were priced at half of what their light passes took (sun-glass 0.58x,
   // material-spheres 0.63x, mis-plates 0.59x), closed ones at up to 1.6x (door-ajar). Fitted to
-  // the light passes of photon mapping everywhere (no lens connections) at 2 light paths per
+  // the light passes of photon mapping everywhere (no lens connections) at 1-2 light paths per
   // pixel on the 14 scenes of the equal-time table, minimising relative error (2 threads,
   // 2026-12-06, docs/adaptive-vcm.md "A light path's price"): per path 0.345, per vertex 0.406,
-  // rms log error 0.42 against 0.79 for vertices alone; what is left is the scenes' materials
-  // and meshes (coffee and material-testball 2.1x, water-caustic 2.7x, veach-bidir 1.6x).
+  // rms log error 0.42 against 0.76 for the old price (0.79 for the best per vertex alone); what is
+  // left is the scenes' materials and meshes (coffee and material-testball 2.1x,
+  // water-caustic 2.7x, veach-bidir 1.6x).
   double light_path = 0.35;
   double light_vertex = 0.41;
   double lens_connection = 0.44;

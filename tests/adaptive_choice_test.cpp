@@ -83,6 +83,7 @@ TEST(AdaptiveChoice, TheMixIsPricedOnProbesThatDidNotChooseIt) {
       const double scored = c["relative_variance_mixed"].get<double>();
       EXPECT_NEAR(scored, kTruth, 0.03 * kTruth) << probes;
     }
-    EXPECT_EQ(rows, 20) << probes;  // (light paths, connections) pairs
+    // (light paths, connections) pairs, each without and with merging
+    EXPECT_EQ(rows, int(AdaptivePlan::kCoreCandidates - 1) / 2) << probes;
   }
 }

@@ -109,3 +109,42 @@ TEST(PixelModes, NearTheLowestTotalOnSmallImages) {
   EXPECT_LT(worst, 0.01);
   EXPECT_GT(product_gap, 4 * chosen_gap);
 }
+
+// With per-pixel weights (a pixel's camera vertices over the image's mean), the camera passes'
+// part of a mode's price is the pixel's own, the light paths' share stays the same in every
+// pixel: among pixels of equal variances the dear ones (many vertices) path trace, where the
+// core's extra cost is largest, and the cheap ones keep the core. Without weights every pixel
+// takes the same mode.
+TEST(PixelModes, DearPixelsPathTraceFirst) {
+  const size_t n = 100;
+  Instance in;
+  std::vector<double> weights;
+  for (size_t p = 0; p < n; ++p) {
+    in.core.push_back(1.0);
+    in.merge.push_back(2.0);
+    in.pt.push_back(1.08);
+    in.stop.push_back(10.0);
+    weights.push_back(p % 2 ? 1.8 : 0.2);  // mean 1
+  }
+  in.price = {3.0, 0.2, 2.6, 2.7, 2.0, 2.0};  // light paths 2.0 of core and of path tracing
+  const PixelChoice uniform = choose_modes(in.core, in.merge, in.pt, &in.stop, in.price, false);
+  for (size_t p = 1; p < n; ++p) ASSERT_EQ(uniform.modes[p], uniform.modes[0]) << p;
+
+  in.price.weights = &weights;
+  const ModePrices dear = in.price.at(1), cheap = in.price.at(0);
+  EXPECT_DOUBLE_EQ(dear.core, 2.0 + 1.8 * 1.0);
+  EXPECT_DOUBLE_EQ(cheap.path_traced, 2.0 + 0.2 * 0.6);
+  EXPECT_DOUBLE_EQ(dear.merge_extra, 1.8 * 0.2);
+  EXPECT_DOUBLE_EQ(dear.stopped, 2.7);
+  const PixelChoice chosen = choose_modes(in.core, in.merge, in.pt, &in.stop, in.price, false);
+  double cost = 0;
+  for (size_t p = 0; p < n; ++p) {
+    EXPECT_EQ(chosen.modes[p], p % 2 ? PixelMode::PathTrace : PixelMode::Bidirectional) << p;
+    const ModePrices q = in.price.at(p);
+    cost += chosen.modes[p] == PixelMode::PathTrace ? q.path_traced : q.core;
+  }
+  EXPECT_NEAR(chosen.cost, cost, 1e-9 * cost);
+  // Better than either mode everywhere, priced per pixel.
+  const double all_core = 100.0 * (2.0 * n + 1.0 * n), all_pt = 108.0 * (2.0 * n + 0.6 * n);
+  EXPECT_LT(total(chosen), std::min(all_core, all_pt));
+}

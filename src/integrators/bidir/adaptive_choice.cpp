@@ -106,7 +106,8 @@ PixelChoice uniform_choice(const PairVariances& v, size_t variant, const ModePri
   out.modes.assign(out.variances.size(), kVariantModes[variant]);
   out.variance = finite_sum(out.variances.size(), [&](size_t p) { return out.variances[p]; });
   for (double x : out.variances) out.missing += std::isfinite(x) ? 0.0 : 1.0;
-  out.cost = variant_pixel_cost(variant, price) * double(out.variances.size());
+  for (size_t p = 0; p < out.variances.size(); ++p)
+    out.cost += variant_pixel_cost(variant, price.at(p));
   return out;
 }
 
@@ -327,12 +328,23 @@ std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector
   return v;
 }
 
+std::vector<double> AdaptivePlan::pixel_cost_weights() const {
+  std::vector<double> w(grid_pixels_);
+  for (size_t p = 0; p < grid_pixels_; ++p) w[p] = double(pixel_vertices_[p]);
+  w = box_blur(w, grid_w_, grid_h_, kBlurRadius);
+  const double mean = finite_sum(grid_pixels_, [&](size_t p) { return w[p]; }) /
+                      std::max(double(grid_pixels_), 1.0);
+  for (double& x : w) x = mean > 0 ? x / mean : 1.0;
+  return w;
+}
+
 void AdaptivePlan::choose(const std::vector<float>& means) {
   const std::vector<Candidate>& list = candidates();
   const double pixels = double(grid_pixels_);
   const PixelWork pw = pixel_work_of(work_, double(probes_), pixels, kProbeConnections);
   const CostModel t = costs_of(work_, measured_);
   update_roulette_factors(means);
+  const std::vector<double> weights = pixel_cost_weights();
   // Every probe, then the even and the odd ones alone (cross-fitting needs one in each).
   const bool cross = probes_ >= 2;
   const std::array<Half, 3> halves{Half::All, Half::Even, Half::Odd};
@@ -365,9 +377,13 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
       v[h].no_merge = relative_variances(j, means, correction[h], halves[h]);
       v[h].merge = relative_variances(j + 1, means, correction[h], halves[h]);
     }
-    const ModePrices price{base_cost(c, pw, t), j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t),
+    const ModePrices price{base_cost(c, pw, t),
+                           j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t),
                            path_tracing_cost(c, pw, t),
-                           v[0].stops ? stop_cost(list[kCoreCandidates + si], pw, t) : 0.0};
+                           v[0].stops ? stop_cost(list[kCoreCandidates + si], pw, t) : 0.0,
+                           light_cost(c, pw, t, true),
+                           light_cost(c, pw, t, false),
+                           &weights};
     PixelChoice choice =
         j == 0 ? choose_modes(pt[0], pt[0], pt[0], nullptr, price, true)
                : choose_modes(v[0].no_merge, v[0].merge, pt[0], v[0].stops, price, false);

@@ -66,6 +66,7 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
   moments_.assign(grid_pixels_ * kCandidates * 3, 0);  // float24 zeros
   moments_odd_.assign(grid_pixels_ * kCandidates * 3, 0);
   roulette_diff_.assign(grid_pixels_ * kCandidates * 3, 0);
+  pixel_vertices_.assign(grid_pixels_, 0.f);
   chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
   roulette_.fill(1.0);
 }
@@ -268,8 +269,9 @@ AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
   return sums;
 }
 
-void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums) {
+void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums, double camera_vertices) {
   const size_t g = grid_index(pixel);
+  pixel_vertices_[g] += float(camera_vertices);  // integers: exact far beyond any probe count
   uint8_t* m = &moments_[g * kCandidates * 3];
   uint8_t* odd = probes_ % 2 == 1 ? &moments_odd_[g * kCandidates * 3] : nullptr;
   for (size_t j = 0; j < kCandidates; ++j) {

@@ -40,7 +40,7 @@ Rgb BidirIntegrator::estimate(const Scene& scene, const CameraSample& sample, Pc
   camera_path(scene, it, sample, rng, acc, arena);
   *nonfinite += acc.nonfinite;
   if (records) {
-    plan_.pixel_end(sample.pixel, acc.candidate_sums);
+    plan_.pixel_end(sample.pixel, acc.candidate_sums, acc.work.camera_vertices);
     if (timed) acc.work.camera_seconds = seconds_since(start);
   }
   add_work(acc.work, records);

@@ -24,7 +24,7 @@ constexpr int kLagrangePasses = 2;  // choose_modes
 
 PixelChoice choose_pixel_modes(const std::vector<double>& no_merge,
                                const std::vector<double>& merge, const std::vector<double>& pt,
-                               const std::vector<double>* stops, const ModePrices& price,
+                               const std::vector<double>* stops, const ModePrices& prices,
                                bool path_tracing_only, const ModeScore& score) {
   const size_t n = pt.size();
   PixelChoice out;
@@ -36,6 +36,7 @@ PixelChoice choose_pixel_modes(const std::vector<double>& no_merge,
   for_pixel_blocks(n, [&](size_t b, size_t begin, size_t end) {
     std::array<double, 6> sum{};
     for (size_t p = begin; p < end; ++p) {
+      const ModePrices price = prices.at(p);
       const double v0 = no_merge[p], v1 = merge[p], vt = pt[p];
       const double vs = stops ? (*stops)[p] : std::numeric_limits<double>::infinity();
       sum[2] += v0;

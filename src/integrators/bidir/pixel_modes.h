@@ -20,9 +20,26 @@ struct PixelChoice {
   double variance_no_merge = 0, variance_all_merge = 0, variance_all_stop = 0;
 };
 
-// What a pixel costs per iteration in each mode under one candidate.
+// What a pixel costs per iteration in each mode under one candidate: the image's mean, and with
+// weights, per pixel (at()).
 struct ModePrices {
   double core = 0, merge_extra = 0, path_traced = 0, stopped = 0;
+  // The light paths' share of core and of path_traced: the same in every pixel.
+  double core_light = 0, path_traced_light = 0;
+  // Per pixel, its camera vertices relative to the image's mean (AdaptivePlan::pixel_vertices_):
+  // what scales the camera passes' part of core, merge_extra and path_traced. stopped stays
+  // the mean (photon mapping's camera subpath ends at its first non-delta vertex).
+  const std::vector<double>* weights = nullptr;
+  ModePrices at(size_t p) const {
+    if (!weights) return *this;
+    const double w = (*weights)[p];
+    ModePrices q = *this;
+    q.core = core_light + (core - core_light) * w;
+    q.merge_extra = merge_extra * w;
+    q.path_traced = path_traced_light + (path_traced - path_traced_light) * w;
+    q.weights = nullptr;
+    return q;
+  }
 };
 
 // How a pixel's (variance, cost) in a mode is scored: their product (each pixel's own

@@ -15,6 +15,11 @@
 # `caustica bench` measures caustica's rays per iteration and the raw Embree rate of the scene,
 # so the table also says what the rays alone cost at Embree's incoherent rate: the floor under
 # any caustica iteration that traces those rays one by one. Medians over ROUNDS (default 3).
+#
+# Whole-process seconds include start-up, the first iteration's allocations and writing the
+# image, which the targets ("per iteration") do not. So each round also runs both programs for
+# one iteration, and a second table gives each round's (T(ITERATIONS) - T(1)) / (ITERATIONS - 1):
+# the seconds of one iteration beyond the first, and their ratio per round.
 set -euo pipefail
 src=${1:?usage: smallvcm_side_by_side.sh SMALLVCM_DIR [ROUNDS] [ITERATIONS] [THREADS]}
 rounds=${2:-3}
@@ -43,22 +48,24 @@ seconds() {  # wall seconds of a command, its output discarded
 for ((r = 1; r <= rounds; ++r)); do
   for a in vcm pt; do
     echo "round $r/$rounds: $a" >&2
-    t=$(cd "$work" && seconds env OMP_NUM_THREADS="$threads" ./smallvcm -s 4 -a "$a" -i "$iterations" \
-      -o "$work/s.hdr")
-    echo "smallvcm $a $t" >>"$work/times"
-    t=$(seconds "$bin" render cornell-glass --integrator "$a" --spp "$iterations" \
-      --threads "$threads" --max-depth 9 --outfile "$work/c.exr" -q)
-    echo "caustica $a $t" >>"$work/times"
+    for n in "$iterations" 1; do
+      t=$(cd "$work" && seconds env OMP_NUM_THREADS="$threads" ./smallvcm -s 4 -a "$a" -i "$n" \
+        -o "$work/s.hdr")
+      echo "smallvcm $a $n $t" >>"$work/times"
+      t=$(seconds "$bin" render cornell-glass --integrator "$a" --spp "$n" \
+        --threads "$threads" --max-depth 9 --outfile "$work/c.exr" -q)
+      echo "caustica $a $n $t" >>"$work/times"
+    done
   done
 done
 
 python3 - "$work/times" "$work/bench.json" "$iterations" "$threads" <<'EOF'
 import json, statistics, sys
 times, bench, iterations, threads = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
-runs = {}
+runs, ones = {}, {}
 for line in open(times):
-    who, algorithm, t = line.split()
-    runs.setdefault((who, algorithm), []).append(float(t))
+    who, algorithm, n, t = line.split()
+    (runs if int(n) == iterations else ones).setdefault((who, algorithm), []).append(float(t))
 b = json.load(open(bench))
 print(f"# {b['machine']['cpu']}, {b['machine']['logical_cores']} logical cores; caustica "
       f"{b['build']['build_type']} {b['build']['commit']}; cornell-glass 512x512, "
@@ -79,4 +86,18 @@ for algorithm in ("vcm", "pt"):
         extra = (f"| **{ours / svcm:.2f}** | {rays / 1e6:.2f} M | {floor_ms:.0f} | {target_ms:.0f} |"
                  if who == "caustica" else "| | | | |")
         print(f"| {who} `{algorithm}` | {cells} | {m:.2f} {extra}")
+if iterations > 1:
+    print(f"\nPer iteration beyond the first, (T({iterations}) - T(1)) / {iterations - 1}, each "
+          "round on its own (seconds, SmallVCM / caustica: caustica / SmallVCM):\n")
+    rounds = len(runs[("smallvcm", "vcm")])
+    print("| | " + " | ".join(f"round {i + 1}" for i in range(rounds)) + " | median ratio |")
+    print("|---" * (rounds + 2) + "|")
+    for algorithm in ("vcm", "pt"):
+        per = {who: [(a - b) / (iterations - 1) for a, b in
+                     zip(runs[(who, algorithm)], ones[(who, algorithm)])]
+               for who in ("smallvcm", "caustica")}
+        ratios = [c / s for c, s in zip(per["caustica"], per["smallvcm"])]
+        cells = " | ".join(f"{s:.3f} / {c:.3f}: {c / s:.2f}x"
+                           for s, c in zip(per["smallvcm"], per["caustica"]))
+        print(f"| `{algorithm}` | {cells} | **{statistics.median(ratios):.2f}** |")
 EOF

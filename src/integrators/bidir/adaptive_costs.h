@@ -36,9 +36,10 @@ struct CostModel {
   // the light passes of photon mapping everywhere (no lens connections) at 1-2 light paths per
   // pixel on the 14 scenes of the equal-time table, minimising relative error (2 threads,
   // 2026-12-06, docs/adaptive-vcm.md "A light path's price"): per path 0.345, per vertex 0.406,
-  // rms log error 0.42 against 0.76 for the old price (0.79 for the best per vertex alone); what is
-  // left is the scenes' materials and meshes (coffee and material-testball 2.1x,
-  // water-caustic 2.7x, veach-bidir 1.6x).
+  // rms log error 0.42 against 0.76 for the old price (0.79 for the best per vertex alone). What
+  // is left (coffee and material-testball 2.1x, water-caustic 2.7x, veach-bidir 1.6x) is not one
+  // count: not the light rays that store no vertex, and on veach-bidir not its lamp's material
+  // (docs/adaptive-vcm.md, "veach-bidir's light paths").
   double light_path = 0.35;
   double light_vertex = 0.41;
   double lens_connection = 0.44;

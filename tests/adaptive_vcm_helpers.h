@@ -11,10 +11,12 @@
 namespace caustica::test {
 
 // The statistics of adaptive-vcm after `iterations` iterations on the scene.
+// budget: the iterations the plan is told it has (default: those rendered; 0: none known).
 inline nlohmann::json adaptive_stats(const Scene& scene, const IntegratorSettings& s,
-                                     int iterations) {
+                                     int iterations, int budget = -1) {
   auto in = make_integrator("adaptive-vcm", s);
-  in->set_budget(iterations, 0);  // as render() does: the probes' schedule reads it
+  // As render() does: the probes' schedule and path tracing's bias weight read it.
+  in->set_budget(budget < 0 ? iterations : budget, 0);
   Film film(scene.camera().width(), scene.camera().height());
   in->prepare(scene, film);
   for (int i = 0; i < iterations; ++i) {

@@ -300,6 +300,71 @@ TEST(AdaptiveVcm, AnInfiniteVarianceIsCountedNotAveragedAway) {
   EXPECT_EQ(pt["pixels_missing_energy"].get<double>(), 49.0);  // the 7 x 7 pooling window
 }
 
+// Energy that only light paths find (here a merge-only contribution of 0.1 in a 4 x 4 block,
+// beside a noisy estimate of 1 everywhere) is path tracing's bias there: 0.01 of relative
+// bias^2 that no number of iterations removes. Where the budget is known it is priced as a
+// variance of bias^2 times the iterations path tracing would render (the same final MSE): at 16
+// iterations the bias costs less than the light paths and merging cost, and the plan path
+// traces; at a million iterations it keeps light paths and merges in the block. Without a
+// budget the missed energy rules path tracing out (AnInfiniteVarianceIsCountedNotAveragedAway).
+TEST(AdaptiveVcm, PathTracingsBiasIsWeighedAgainstTheBudget) {
+  const int w = 32, h = 32;
+  for (const double budget : {16.0, 1e6}) {
+    SCOPED_TRACE(budget);
+    bidir::AdaptivePlan plan(w, h, /*measured_costs=*/false);
+    bidir::MisCounts counts;  // a probe's: one light path per pixel, two connections, merging
+    counts.light_trace = float(w * h);
+    counts.connect = 2;
+    counts.merge = float(w * h) * 3.14159f * 0.01f * 0.01f;
+    bidir::TechniqueTerms merge_only;
+    merge_only.own = bidir::TechniqueClass::Merge;
+    const float a = std::sqrt(3.f * 0.04f);
+    uint32_t state = 12345;
+    auto uniform = [&] {  // in [-1, 1)
+      state = state * 1664525u + 1013904223u;
+      return float(state >> 8) / float(1u << 23) - 1.f;
+    };
+    auto in_block = [&](size_t p) {
+      return p % w >= 14 && p % w < 18 && p / w >= 14 && p / w < 18;
+    };
+    for (int probe = 0; probe < 3; ++probe) {
+      plan.begin_probe(0.01f);
+      for (size_t p = 0; p < size_t(w * h); ++p) {
+        bidir::AdaptivePlan::CandidateSums sums = plan.pixel_start(p);
+        plan.add(sums, 0.9f + a * uniform(), nullptr, counts);  // every candidate's
+        if (in_block(p)) plan.add(sums, 0.1f, &merge_only, counts);
+        plan.pixel_end(p, sums);
+      }
+      bidir::ProbeWork work;
+      work.light_paths = w * h;
+      // Long light paths: light paths cost more than path tracing does.
+      work.light_vertices = 12.0 * w * h;
+      work.camera_vertices = work.nondelta_camera_vertices = 2.0 * w * h;
+      work.connections = 4.0 * w * h;
+      work.merge_queries = 2.0 * w * h;
+      work.photons = 24.0 * w * h;
+      plan.set_budget(budget, 0, 0);
+      std::vector<float> means(size_t(w * h));
+      for (size_t p = 0; p < means.size(); ++p) means[p] = in_block(p) ? 1.f : 0.9f;
+      plan.finish_probe(work, means);
+    }
+    nlohmann::json stats;
+    plan.report(stats);
+    const auto& last = stats["adaptive"]["history"].back();
+    EXPECT_EQ(last["path_tracing_bias_iterations"].get<double>(), budget);
+    // 16 of 1024 pixels with (0.1)^2 / 1.01, pooled.
+    EXPECT_NEAR(last["path_tracing_relative_bias"].get<double>(), 16 * 0.01 / 1.01 / 1024, 1e-6);
+    const bidir::IterationPlan chosen = plan.plan(3);
+    if (budget < 100) {
+      EXPECT_EQ(chosen.light_paths, 0u);
+    } else {
+      EXPECT_GT(chosen.light_paths, 0u);
+      EXPECT_TRUE(chosen.merges(16 * w + 16));
+      EXPECT_EQ(last["candidates"][0]["pixels_missing_energy"].get<double>(), 0.0);
+    }
+  }
+}
+
 // A pixel's variance estimate from a few probes, second moment minus the film's mean^2, is
 // noisy and often negative where the variance is small beside mean^2. Clamped at zero pixel by
 // pixel it was biased up by the noise: on point-room (160 x 120, 64 iterations, 7 probes) one

@@ -149,13 +149,26 @@ TEST(AdaptiveVcm, KeepsMergingForCausticsAndReportsWhy) {
 // one pixel whose variance was infinite for every candidate without merging (the caustic seen
 // through the ball) made every score NaN (inf - inf in the 7 x 7 pooling), and the choice fell
 // back to path tracing, which misses the caustic: the image converged to the wrong value.
+// That is the choice without a budget (an unbounded render: missed energy rules path tracing
+// out). Told it has 32 iterations, the plan instead prices path tracing's bias for 32
+// iterations (PathTracingsBiasIsWeighedAgainstTheBudget): the caustic's missed energy is seen
+// and priced, not counted as pixels missing energy.
 TEST(AdaptiveVcm, KeepsLightPathsForACausticOnlyTheyMakeAndPathTracesElsewhere) {
   auto scene = load_scene(std::string(CAUSTICA_SCENES) + "/sun-glass.pbrt");
   // The sun's light paths start on a disk as wide as the 100 x 100 ground: one in about 5000
   // reaches the ball, so the probes need the file's 160 x 120 light paths to see the caustic.
   IntegratorSettings s;
   s.max_depth = 8;
-  const nlohmann::json stats = adaptive_stats(*scene, s, 32);
+  {
+    const nlohmann::json budgeted = adaptive_stats(*scene, s, 32);
+    for (const auto& h : budgeted["adaptive"]["history"]) {
+      SCOPED_TRACE(h["after_probe"].get<int>());
+      EXPECT_EQ(h["path_tracing_bias_iterations"].get<double>(), 32.0);
+      EXPECT_GT(h["path_tracing_relative_bias"].get<double>(), 0.0);
+      EXPECT_EQ(h["candidates"][0]["pixels_missing_energy"].get<double>(), 0.0);
+    }
+  }
+  const nlohmann::json stats = adaptive_stats(*scene, s, 32, /*budget=*/0);
   const auto& a = stats["adaptive"];
   ASSERT_GE(a["history"].size(), 1u);  // a choice after each probe from the second on
   for (const auto& h : a["history"]) {

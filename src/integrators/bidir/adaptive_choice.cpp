@@ -252,7 +252,9 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
 
 double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means,
                                        Half half) const {
-  const double mean = means[p];
+  // Path tracing's estimate there has the mean of the paths it makes (pt_missing_).
+  const double mean = j == 0 ? means[p] - pt_missing_[p] / double(probes_) : double(means[p]);
+  const double film_mean = means[p];
   const size_t i = (p * kCandidates + j) * 3;
   const double all = get_float24(&moments_[i]);
   const int odd_probes = probes_ / 2;
@@ -261,7 +263,58 @@ double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<flo
                             ? get_float24(&moments_odd_[i]) / double(odd_probes)
                             : (all - get_float24(&moments_odd_[i])) / double(probes_ - odd_probes);
   // Signed: clamped only after pooling (relative_variances).
-  return (moment - mean * mean) / (mean * mean + kRelEps) * roulette_[j];
+  return (moment - mean * mean) / (film_mean * film_mean + kRelEps) * roulette_[j];
+}
+
+std::vector<double> AdaptivePlan::path_tracing_bias(const std::vector<float>& means,
+                                                    double weight) const {
+  std::vector<double> bias(grid_pixels_);
+  if (!std::isfinite(weight)) {
+    // Ruled out wherever a probe saw it miss energy, pooled as an infinite variance would be.
+    for (size_t p = 0; p < grid_pixels_; ++p) bias[p] = pt_missing_[p] != 0 ? 1.0 : 0.0;
+    bias = box_blur(bias, grid_w_, grid_h_, kBlurRadius);
+    for (double& x : bias) x = x > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+    return bias;
+  }
+  // The square of the mean missed energy over the probes. It keeps the mean's noise (its
+  // expectation is the bias^2 plus the variance of the mean), which errs toward the light
+  // paths: a caustic path that only a few probes found weighs as a bias. Taking that noise out
+  // (the mean of m_k m_l over pairs of different probes, unbiased) left sun-glass's sun caustic,
+  // which one probe in nine finds in a pixel, at 1e-11 and chose path tracing.
+  for (size_t p = 0; p < grid_pixels_; ++p) {
+    const double m = pt_missing_[p] / double(probes_);
+    bias[p] = m * m / (double(means[p]) * means[p] + kRelEps);
+  }
+  bias = box_blur(bias, grid_w_, grid_h_, kBlurRadius);
+  for (double& x : bias) x = std::max(x, 0.0) * weight;
+  return bias;
+}
+
+double AdaptivePlan::path_tracing_bias_weight(const PixelWork& pw, const CostModel& t) const {
+  double n = std::numeric_limits<double>::infinity();
+  if (budget_iterations_ > 0) n = budget_iterations_;  // --spp
+  if (!(budget_seconds_ > 0 && elapsed_seconds_ > 0)) return n;
+  // --time: the iterations so far, and those path tracing would render in the seconds left at
+  // the pace the model's costs have run so far (its predicted microseconds per pixel of every
+  // iteration, accounted as schedule_next_probe does; before the first choice every iteration
+  // was a full probe).
+  const uint64_t probe =
+      probe_all_ || probes_ <= kFirstProbes ? uint64_t(probes_ - 1) : next_probe_;
+  double spent = 0;
+  if (probe_iterations_.empty()) {
+    const Candidate probe_config{1.f, kProbeConnections, true};
+    const double recorded = double(grid_pixels_) / double(pixels_);
+    spent = double(probe + 1) * (base_cost(probe_config, pw, t) + merge_cost(probe_config, pw, t)) *
+            (recorded * kProbeRecordingFactor + (1 - recorded));
+  } else {
+    spent = spent_cost_ + double(probe - probe_iterations_.back() - 1) * last_choice_cost_ +
+            probe_cost_;
+  }
+  const double pt_cost = path_tracing_cost(candidates()[0], pw, t);
+  if (!(spent > 0) || !(pt_cost > 0)) return n;
+  const double seconds_per_cost = elapsed_seconds_ / spent;
+  const double rest = std::max(0.0, budget_seconds_ - elapsed_seconds_);
+  return std::min(n, double(probe + 1) + rest / (seconds_per_cost * pt_cost));
 }
 
 void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
@@ -275,7 +328,8 @@ void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
     std::vector<double> diff(grid_pixels_);
     double variance = 0;
     for (size_t p = 0; p < grid_pixels_; ++p) {
-      const double v = relative_variance(p, j, means);
+      const double v = j == 0 && pt_missing_[p] != 0 ? std::numeric_limits<double>::infinity()
+                                                     : relative_variance(p, j, means);
       diff[p] = std::numeric_limits<double>::infinity();
       if (!std::isfinite(v)) continue;
       variance += v;
@@ -302,7 +356,8 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
   for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p) {
       double least = std::numeric_limits<double>::infinity();
-      for (size_t j = 0; j < kCandidates; ++j)
+      // Path tracing where it misses energy is out, as every candidate that does (infinite).
+      for (size_t j = pt_missing_[p] != 0 ? 1 : 0; j < kCandidates; ++j)
         least = std::min(least, relative_variance(p, j, means, half));
       shared[p] = least;
     }
@@ -315,9 +370,9 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
   return shared;
 }
 
-std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector<float>& means,
-                                                     const std::vector<double>& correction,
-                                                     Half half) const {
+std::vector<double> AdaptivePlan::relative_variances(
+    size_t j, const std::vector<float>& means, const std::vector<double>& correction, Half half,
+    const std::vector<double>* pooled_extra) const {
   std::vector<double> v(grid_pixels_);
   for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)
@@ -325,6 +380,8 @@ std::vector<double> AdaptivePlan::relative_variances(size_t j, const std::vector
   });
   v = box_blur(v, grid_w_, grid_h_, kBlurRadius);
   for (double& x : v) x = std::max(x, 0.0);  // inf stays inf
+  if (pooled_extra)
+    for (size_t p = 0; p < grid_pixels_; ++p) v[p] += (*pooled_extra)[p];
   return v;
 }
 
@@ -352,9 +409,16 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   std::array<std::vector<double>, 3> correction, pt;
   // Photon mapping per light-path factor (kLightPathFactors' order).
   std::array<std::array<std::vector<double>, kStopCandidates>, 3> stop;
+  // Path tracing's bias where it misses energy, weighted by the iterations it would render.
+  bias_iterations_ = path_tracing_bias_weight(pw, t);
+  const std::vector<double> pt_bias = path_tracing_bias(means, bias_iterations_);
+  relative_bias_sum_ =
+      std::isfinite(bias_iterations_) && bias_iterations_ > 0
+          ? finite_sum(grid_pixels_, [&](size_t p) { return pt_bias[p]; }) / bias_iterations_
+          : 0.0;
   for (size_t h = 0; h < sets; ++h) {
     correction[h] = shared_firefly_correction(means, halves[h]);
-    pt[h] = relative_variances(0, means, correction[h], halves[h]);
+    pt[h] = relative_variances(0, means, correction[h], halves[h], &pt_bias);
     for (size_t i = 0; i < kStopCandidates; ++i)
       stop[h][i] = relative_variances(kCoreCandidates + i, means, correction[h], halves[h]);
   }
@@ -418,6 +482,11 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     std::fill(best_choice.modes.begin(), best_choice.modes.end(), PixelMode(force_mode_));
   take_choice(best_j, best_choice.modes);
   chosen_variance_ = std::move(best_choice.variances);
+  // What rendering the choice shows (check_last_choice) is its noise: path tracing's bias is
+  // not part of it.
+  for (size_t p = 0; p < grid_pixels_; ++p)
+    if (best_choice.modes[p] == PixelMode::PathTrace && std::isfinite(pt_bias[p]))
+      chosen_variance_[p] -= pt_bias[p];
   chosen_cost_ = best_choice.cost / pixels;
   predict_probe_cost(pw, t);
   record_choice(kVariantNames[best_variant], t, std::move(table));
@@ -430,6 +499,12 @@ void AdaptivePlan::record_choice(const char* variant, const CostModel& t, nlohma
                       {"light_path_factor", c.light_path_factor},
                       {"connections", c.connections},
                       {"variant", variant},
+                      // Path tracing's missed energy: its relative bias^2 per pixel, and the
+                      // iterations that weighted it (null: no budget, so it was ruled out).
+                      {"path_tracing_relative_bias", relative_bias_sum_ / double(grid_pixels_)},
+                      {"path_tracing_bias_iterations", std::isfinite(bias_iterations_)
+                                                           ? nlohmann::json(bias_iterations_)
+                                                           : nlohmann::json(nullptr)},
                       {"merge_fraction", fraction_of(modes_, PixelMode::Merge)},
                       {"path_trace_fraction", fraction_of(modes_, PixelMode::PathTrace)},
                       {"stop_fraction", fraction_of(modes_, PixelMode::Stop)},

@@ -67,6 +67,7 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
   moments_odd_.assign(grid_pixels_ * kCandidates * 3, 0);
   roulette_diff_.assign(grid_pixels_ * kCandidates * 3, 0);
   pixel_vertices_.assign(grid_pixels_, 0.f);
+  pt_missing_.assign(grid_pixels_, 0.f);
   chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
   roulette_.fill(1.0);
 }
@@ -181,6 +182,7 @@ IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
 
 void AdaptivePlan::begin_probe(float radius) {
   light_sums_.assign(grid_pixels_ * kLightSums * kCandidates, to_bfloat16(0.f));
+  light_missing_pt_.assign(grid_pixels_, 0.f);
   const std::vector<Candidate>& list = candidates();
   for (size_t j = 0; j < kCandidates; ++j) {
     const MisCounts n = counts_of(list[j], pixels_, radius);
@@ -199,6 +201,14 @@ void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* t
     for (size_t j = 0; j < kCandidates; ++j) sums.r[j] += value;
     return;
   }
+  // Where path tracing cannot make the path (below: Q' = 0 for candidate 0), its variance
+  // stays that of the paths it makes, and the energy it misses is kept apart (missing_pt);
+  // every other candidate that misses it gets an infinite D.
+  constexpr std::array<float, kCoreCandidates> kUnmade = [] {
+    std::array<float, kCoreCandidates> a{};
+    for (size_t j = 1; j < kCoreCandidates; ++j) a[j] = std::numeric_limits<float>::infinity();
+    return a;
+  }();
   // The probe's counts are all positive, so a finite Q means finite terms: plain arithmetic.
   const float q = terms->denominator(counts), own = counts.of(terms->own);
   if (!(q > 0) || !std::isfinite(q) || !(own > 0)) return;
@@ -241,15 +251,20 @@ void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* t
     const float own_g = value * ratio;
     sums.u[j] += own_g * own_g * (own_count[j] * inv_own) - f2 * ratio;
     sum[j] += g;
-    sums.d[j] = (sums.d[j] + f2 * ratio - squares * g * g) +
-                (made ? 0.f : std::numeric_limits<float>::infinity());
+    sums.d[j] = (sums.d[j] + f2 * ratio - squares * g * g) + (made ? 0.f : kUnmade[j]);
   }
+  // Candidate 0 (path tracing) has no light paths: only its own emitter class makes paths.
+  if (!(own_count[0] + emitter + table_.light_trace[0] * light_trace + table_.connect[0] * connect +
+            table_.merge[0] * merge >
+        0))
+    sums.missing_pt += value;
 }
 
 void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTerms* terms,
                                    const MisCounts& counts) {
   CandidateSums sums = pixel_start(pixel);
   add(sums, value, terms, counts);
+  light_missing_pt_[grid_index(pixel)] = sums.missing_pt;
   uint16_t* stored = &light_sums_[grid_index(pixel) * kLightSums * kCandidates];
   for (size_t j = 0; j < kCandidates; ++j) {
     stored[j] = to_bfloat16(sums.r[j]);
@@ -266,12 +281,14 @@ AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
     sums.d[j] = from_bfloat16(stored[kCandidates + j]);
     sums.u[j] = from_bfloat16(stored[2 * kCandidates + j]);
   }
+  sums.missing_pt = light_missing_pt_.empty() ? 0.f : light_missing_pt_[grid_index(pixel)];
   return sums;
 }
 
 void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums, double camera_vertices) {
   const size_t g = grid_index(pixel);
   pixel_vertices_[g] += float(camera_vertices);  // integers: exact far beyond any probe count
+  pt_missing_[g] += sums.missing_pt;
   uint8_t* m = &moments_[g * kCandidates * 3];
   uint8_t* odd = probes_ % 2 == 1 ? &moments_odd_[g * kCandidates * 3] : nullptr;
   for (size_t j = 0; j < kCandidates; ++j) {
@@ -305,6 +322,7 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   // The light-tracing sums (6 bytes per pixel and candidate) are only needed while a probe
   // renders; released before the choice, so that its buffers do not add to them.
   std::vector<uint16_t>().swap(light_sums_);
+  std::vector<float>().swap(light_missing_pt_);
   // The cost model's photons are those of one light path per pixel (merge_cost scales them
   // with a candidate's factor); a sparse probe traces the chosen light paths.
   ProbeWork normalized = w;

@@ -208,8 +208,11 @@ class AdaptivePlan {
   enum class Share { None, OwnLightPath, RandomLightPath };  // of a connection
   // u: the Russian-roulette difference (roulette_diff_): sum over contributions of
   // G_i^2 (n'_t / n_t) - F_i^2 Q_i / Q'_i.
+  // missing_pt: the sum of the contributions path tracing's techniques cannot make (a caustic
+  // of a delta light seen on a diffuse surface): the energy it would miss (pt_missing_).
   struct CandidateSums {
     std::array<float, kCandidates> r{}, s0{}, s1{}, d{}, u{};
+    float missing_pt = 0;
   };
   // radius: the probe's merge radius (the candidates' merge counts N' pi r^2).
   void begin_probe(float radius);
@@ -266,9 +269,11 @@ class AdaptivePlan {
   std::vector<double> shared_firefly_correction(const std::vector<float>& means,
                                                 Half half = Half::All) const;
   // Per pixel: candidate j's relative variance, corrected and pooled over neighbours.
+  // pooled_extra (path tracing's bias, path_tracing_bias): added after pooling.
   std::vector<double> relative_variances(size_t j, const std::vector<float>& means,
                                          const std::vector<double>& correction,
-                                         Half half = Half::All) const;
+                                         Half half = Half::All,
+                                         const std::vector<double>* pooled_extra = nullptr) const;
   // Scores every candidate from the probes so far and takes the best (adaptive_choice.cpp).
   void choose(const std::vector<float>& means);
   // Adds the choice just taken to the history: its option (variant), costs and candidate table.
@@ -334,6 +339,25 @@ class AdaptivePlan {
   // choice 1.05-1.21 with it, 0.98-1.11 with these weights).
   std::vector<float> pixel_vertices_;
   std::vector<double> pixel_cost_weights() const;
+  // Per grid pixel: the energy path tracing misses (CandidateSums::missing_pt), summed over the
+  // probes. Its mean is the bias of path tracing's estimate there, and its square divided by
+  // (mean^2 + 0.01) what that bias adds to the relative MSE however long pt renders. Where the
+  // budget is known, the candidate without light paths (and a pixel that path traces alone)
+  // is priced with that bias instead of being ruled out (path_tracing_bias_weight): a faint
+  // caustic of a delta light can cost less in error than the light paths that find it cost in
+  // noise elsewhere (material-spheres and sun-glass at 20 s: `pt` beat every configuration with
+  // light paths by 1.45x and 1.81x). A bright caustic's bias outweighs that; and as the budget
+  // grows, so does the weight, so the choice converges to the unbiased one.
+  std::vector<float> pt_missing_;
+  // Per grid pixel, pooled as the variances are: what path tracing's bias adds to its variance
+  // per iteration, the relative bias^2 times the weight that turns it into a per-iteration
+  // variance, the iterations path tracing would render in the budget
+  // (path_tracing_bias_weight). Without a budget (an infinite weight) any missed energy rules
+  // it out, as every candidate that misses energy is.
+  std::vector<double> path_tracing_bias(const std::vector<float>& means, double weight) const;
+  double path_tracing_bias_weight(const PixelWork& pw, const CostModel& t) const;
+  double bias_iterations_ = 0;    // the last choice's weight, for the report
+  double relative_bias_sum_ = 0;  // and path tracing's relative bias^2 summed over pixels
   std::array<double, kCandidates> roulette_;
   // pixels x (R, D, U) x candidates: this probe's light-tracing sums, in bfloat16 while the
   // probe renders; the pixel's camera pass starts from them (pixel_start), so they reach the
@@ -343,6 +367,7 @@ class AdaptivePlan {
   // stage, was a quarter of a probe's time on cornell-caustics.)
   static constexpr size_t kLightSums = 3;
   std::vector<uint16_t> light_sums_;
+  std::vector<float> light_missing_pt_;  // per grid pixel: the splats' missing_pt
   // The candidates' counts per class for this probe's radius (structure of arrays).
   struct CountTable {
     std::array<float, kCandidates> emitter{}, light_trace{}, connect{}, merge{};

@@ -178,6 +178,8 @@ TEST(AdaptiveVcm, KeepsLightPathsForACausticOnlyTheyMakeAndPathTracesElsewhere) 
     EXPECT_GT(h["merge_fraction"].get<double>(), 0.0);
     const auto& pt = h["candidates"][0];
     EXPECT_GT(pt["pixels_missing_energy"].get<double>(), 0.0);
+    EXPECT_GT(h["path_tracing_relative_bias"].get<double>(), 0.0);  // reported, though not priced
+    EXPECT_TRUE(h["path_tracing_bias_iterations"].is_null());
   }
   EXPECT_TRUE(a.contains("path_trace_mask"));
 }

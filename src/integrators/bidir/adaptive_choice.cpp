@@ -266,27 +266,29 @@ double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<flo
   return (moment - mean * mean) / (film_mean * film_mean + kRelEps) * roulette_[j];
 }
 
-std::vector<double> AdaptivePlan::path_tracing_bias(const std::vector<float>& means,
-                                                    double weight) const {
-  std::vector<double> bias(grid_pixels_);
-  if (!std::isfinite(weight)) {
-    // Ruled out wherever a probe saw it miss energy, pooled as an infinite variance would be.
-    for (size_t p = 0; p < grid_pixels_; ++p) bias[p] = pt_missing_[p] != 0 ? 1.0 : 0.0;
-    bias = box_blur(bias, grid_w_, grid_h_, kBlurRadius);
-    for (double& x : bias) x = x > 0 ? std::numeric_limits<double>::infinity() : 0.0;
-    return bias;
-  }
+std::vector<double> AdaptivePlan::path_tracing_bias(const std::vector<float>& means, double weight,
+                                                    double* relative_sum) const {
   // The square of the mean missed energy over the probes. It keeps the mean's noise (its
   // expectation is the bias^2 plus the variance of the mean), which errs toward the light
   // paths: a caustic path that only a few probes found weighs as a bias. Taking that noise out
   // (the mean of m_k m_l over pairs of different probes, unbiased) left sun-glass's sun caustic,
   // which one probe in nine finds in a pixel, at 1e-11 and chose path tracing.
+  std::vector<double> bias(grid_pixels_);
   for (size_t p = 0; p < grid_pixels_; ++p) {
     const double m = pt_missing_[p] / double(probes_);
     bias[p] = m * m / (double(means[p]) * means[p] + kRelEps);
   }
   bias = box_blur(bias, grid_w_, grid_h_, kBlurRadius);
-  for (double& x : bias) x = std::max(x, 0.0) * weight;
+  for (double& x : bias) x = std::max(x, 0.0);
+  *relative_sum = finite_sum(grid_pixels_, [&](size_t p) { return bias[p]; });
+  if (std::isfinite(weight)) {
+    for (double& x : bias) x *= weight;
+    return bias;
+  }
+  // Ruled out wherever a probe saw it miss energy, pooled as an infinite variance would be.
+  for (size_t p = 0; p < grid_pixels_; ++p) bias[p] = pt_missing_[p] != 0 ? 1.0 : 0.0;
+  bias = box_blur(bias, grid_w_, grid_h_, kBlurRadius);
+  for (double& x : bias) x = x > 0 ? std::numeric_limits<double>::infinity() : 0.0;
   return bias;
 }
 
@@ -411,11 +413,8 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   std::array<std::array<std::vector<double>, kStopCandidates>, 3> stop;
   // Path tracing's bias where it misses energy, weighted by the iterations it would render.
   bias_iterations_ = path_tracing_bias_weight(pw, t);
-  const std::vector<double> pt_bias = path_tracing_bias(means, bias_iterations_);
-  relative_bias_sum_ =
-      std::isfinite(bias_iterations_) && bias_iterations_ > 0
-          ? finite_sum(grid_pixels_, [&](size_t p) { return pt_bias[p]; }) / bias_iterations_
-          : 0.0;
+  const std::vector<double> pt_bias =
+      path_tracing_bias(means, bias_iterations_, &relative_bias_sum_);
   for (size_t h = 0; h < sets; ++h) {
     correction[h] = shared_firefly_correction(means, halves[h]);
     pt[h] = relative_variances(0, means, correction[h], halves[h], &pt_bias);

@@ -354,7 +354,9 @@ class AdaptivePlan {
   // variance, the iterations path tracing would render in the budget
   // (path_tracing_bias_weight). Without a budget (an infinite weight) any missed energy rules
   // it out, as every candidate that misses energy is.
-  std::vector<double> path_tracing_bias(const std::vector<float>& means, double weight) const;
+  // relative_sum: the relative bias^2 summed over the pixels (unweighted, for the report).
+  std::vector<double> path_tracing_bias(const std::vector<float>& means, double weight,
+                                        double* relative_sum) const;
   double path_tracing_bias_weight(const PixelWork& pw, const CostModel& t) const;
   double bias_iterations_ = 0;    // the last choice's weight, for the report
   double relative_bias_sum_ = 0;  // and path tracing's relative bias^2 summed over pixels

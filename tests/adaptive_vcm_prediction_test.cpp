@@ -301,8 +301,8 @@ TEST(AdaptiveVcm, AnInfiniteVarianceIsCountedNotAveragedAway) {
 }
 
 // Energy that only light paths find (here a merge-only contribution of 0.1 in a 4 x 4 block,
-// beside a noisy estimate of 1 everywhere) is path tracing's bias there: 0.01 of relative
-// bias^2 that no number of iterations removes. Where the budget is known it is priced as a
+// on top of a noisy estimate of 0.9 that every candidate makes) is path tracing's bias there:
+// 0.01 / 1.01 of relative bias^2 that no number of iterations removes. Where the budget is known it is priced as a
 // variance of bias^2 times the iterations path tracing would render (the same final MSE): at 16
 // iterations the bias costs less than the light paths and merging cost, and the plan path
 // traces; at a million iterations it keeps light paths and merges in the block. Without a

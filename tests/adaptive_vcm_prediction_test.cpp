@@ -302,10 +302,10 @@ TEST(AdaptiveVcm, AnInfiniteVarianceIsCountedNotAveragedAway) {
 
 // Energy that only light paths find (here a merge-only contribution of 0.1 in a 4 x 4 block,
 // on top of a noisy estimate of 0.9 that every candidate makes) is path tracing's bias there:
-// 0.01 / 1.01 of relative bias^2 that no number of iterations removes. Where the budget is known it is priced as a
-// variance of bias^2 times the iterations path tracing would render (the same final MSE): at 16
-// iterations the bias costs less than the light paths and merging cost, and the plan path
-// traces; at a million iterations it keeps light paths and merges in the block. Without a
+// 0.01 / 1.01 of relative bias^2 that no number of iterations removes. Where the budget is known it
+// is priced as a variance of bias^2 times the iterations path tracing would render (the same final
+// MSE): at 16 iterations the bias costs less than the light paths and merging cost, and the plan
+// path traces; at a million iterations it keeps light paths and merges in the block. Without a
 // budget the missed energy rules path tracing out (AnInfiniteVarianceIsCountedNotAveragedAway).
 TEST(AdaptiveVcm, PathTracingsBiasIsWeighedAgainstTheBudget) {
   const int w = 32, h = 32;

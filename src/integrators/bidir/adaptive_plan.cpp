@@ -27,6 +27,47 @@ MisCounts counts_of(const AdaptivePlan::Candidate& c, size_t pixels, float radiu
   n.merge = c.merge ? n.light_trace * kPi * radius * radius : 0.f;
   return n;
 }
+
+using Share = AdaptivePlan::Share;
+
+// One recorded contribution's values that every core candidate's term in add() shares.
+struct CoreTerms {
+  float q, value, f2, inv_own, emitter, light_trace, connect, merge;
+};
+
+// The core candidates' part of add() for one kind of share, candidates [begin, end), without a
+// branch, so that the loop vectorises (GCC 12 at -O3: four candidates per SSE instruction; the
+// loop as add() once wrote it, with selections around the division, stayed scalar). The
+// pointers are parameters because GCC honours restrict only there. unmade: what D gains where
+// the candidate does not make the path (Q' = 0), a constant per call: GCC turns a table of it
+// into a value carried from one iteration to the next, which does not vectorise.
+template <Share kShare>
+void add_core(size_t begin, size_t end, float unmade, float* __restrict sum, float* __restrict u,
+              float* __restrict d, const float* __restrict own_count, const float* __restrict lt,
+              const float* __restrict cn, const float* __restrict mg, const CoreTerms t) {
+  for (size_t j = begin; j < end; ++j) {
+    const float q_candidate =
+        own_count[j] + t.emitter + lt[j] * t.light_trace + cn[j] * t.connect + mg[j] * t.merge;
+    // made: 1 where the candidate makes the path, else 0. Then ratio = q / Q', or 0: the
+    // divisor is Q' + 0 (exact) or 1, so that no division depends on a condition.
+    const float made = q_candidate > 0 ? 1.f : 0.f;
+    const float ratio = t.q / (q_candidate + (1.f - made)) * made;
+    // The contribution under the candidate: a connection counts once per connection the
+    // candidate makes (none if it makes none); other techniques scale with their sample count.
+    const float scale =
+        kShare == Share::None ? own_count[j] * t.inv_own : std::min(own_count[j], 1.f);
+    const float g = t.value * ratio * scale;
+    // How often g^2 enters the moment (pixel_end): a random light path's connection c' - 1
+    // times.
+    const float squares = kShare == Share::RandomLightPath ? own_count[j] - 1 : 1.f;
+    // The candidate's own techniques' estimate of this sample's part of its diagonal: n'_t
+    // samples where the probe took n_t (roulette_diff_).
+    const float own_g = t.value * ratio;
+    u[j] += own_g * own_g * (own_count[j] * t.inv_own) - t.f2 * ratio;
+    sum[j] += g;
+    d[j] = (d[j] + t.f2 * ratio - squares * g * g) + (made > 0 ? 0.f : unmade);
+  }
+}
 }  // namespace
 
 double fraction_of(const std::vector<PixelMode>& modes, PixelMode mode) {
@@ -201,14 +242,6 @@ void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* t
     for (size_t j = 0; j < kCandidates; ++j) sums.r[j] += value;
     return;
   }
-  // Where path tracing cannot make the path (below: Q' = 0 for candidate 0), its variance
-  // stays that of the paths it makes, and the energy it misses is kept apart (missing_pt);
-  // every other candidate that misses it gets an infinite D.
-  constexpr std::array<float, kCoreCandidates> kUnmade = [] {
-    std::array<float, kCoreCandidates> a{};
-    for (size_t j = 1; j < kCoreCandidates; ++j) a[j] = std::numeric_limits<float>::infinity();
-    return a;
-  }();
   // The probe's counts are all positive, so a finite Q means finite terms: plain arithmetic.
   const float q = terms->denominator(counts), own = counts.of(terms->own);
   if (!(q > 0) || !std::isfinite(q) || !(own > 0)) return;
@@ -228,30 +261,31 @@ void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* t
     sums.d[j] =
         sums.d[j] + f2 * ratio - g * g + (made ? 0.f : std::numeric_limits<float>::infinity());
   }
-  std::array<float, kCandidates>& sum = share == Share::None           ? sums.r
-                                        : share == Share::OwnLightPath ? sums.s0
-                                                                       : sums.s1;
-  // Written without branches, so that the loop vectorises (with -fno-trapping-math for this
-  // file: src/CMakeLists.txt). A candidate none of whose techniques makes this path (Q' = 0)
-  // would miss the energy: ratio 0, and D becomes infinite.
-  for (size_t j = 0; j < kCoreCandidates; ++j) {
-    const float q_candidate = own_count[j] + emitter + table_.light_trace[j] * light_trace +
-                              table_.connect[j] * connect + table_.merge[j] * merge;
-    const bool made = q_candidate > 0;
-    const float ratio = q / (made ? q_candidate : q) * (made ? 1.f : 0.f);
-    // The contribution under the candidate: a connection counts once per connection the
-    // candidate makes (none if it makes none); other techniques scale with their sample count.
-    const float scale = share == Share::None ? own_count[j] * inv_own : std::min(own_count[j], 1.f);
-    const float g = value * ratio * scale;
-    // How often g^2 enters the moment (pixel_end): a random light path's connection c' - 1
-    // times.
-    const float squares = share == Share::RandomLightPath ? own_count[j] - 1 : 1.f;
-    // The candidate's own techniques' estimate of this sample's part of its diagonal: n'_t
-    // samples where the probe took n_t (roulette_diff_).
-    const float own_g = value * ratio;
-    sums.u[j] += own_g * own_g * (own_count[j] * inv_own) - f2 * ratio;
-    sum[j] += g;
-    sums.d[j] = (sums.d[j] + f2 * ratio - squares * g * g) + (made ? 0.f : kUnmade[j]);
+  const CoreTerms t{q, value, f2, inv_own, emitter, light_trace, connect, merge};
+  float *u = sums.u.data(), *d = sums.d.data();
+  const float *own_n = own_count.data(), *lt = table_.light_trace.data(),
+              *cn = table_.connect.data(), *mg = table_.merge.data();
+  float* sum = share == Share::None           ? sums.r.data()
+               : share == Share::OwnLightPath ? sums.s0.data()
+                                              : sums.s1.data();
+  // Path tracing (candidate 0) keeps its variance where it cannot make the path (the energy it
+  // misses is kept apart below); every other candidate that misses it gets an infinite D.
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  auto core = [&](auto kind) {
+    constexpr Share kShare = decltype(kind)::value;
+    add_core<kShare>(0, 1, 0.f, sum, u, d, own_n, lt, cn, mg, t);
+    add_core<kShare>(1, kCoreCandidates, kInf, sum, u, d, own_n, lt, cn, mg, t);
+  };
+  switch (share) {
+    case Share::None:
+      core(std::integral_constant<Share, Share::None>());
+      break;
+    case Share::OwnLightPath:
+      core(std::integral_constant<Share, Share::OwnLightPath>());
+      break;
+    case Share::RandomLightPath:
+      core(std::integral_constant<Share, Share::RandomLightPath>());
+      break;
   }
   // Candidate 0 (path tracing) has no light paths: only its own emitter class makes paths.
   if (!(own_count[0] + emitter + table_.light_trace[0] * light_trace + table_.connect[0] * connect +

@@ -302,11 +302,19 @@ TEST(AdaptiveVcm, AnInfiniteVarianceIsCountedNotAveragedAway) {
 
 // Energy that only light paths find (here a merge-only contribution of 0.1 in a 4 x 4 block,
 // on top of a noisy estimate of 0.9 that every candidate makes) is path tracing's bias there:
-// 0.01 / 1.01 of relative bias^2 that no number of iterations removes. Where the budget is known it
+// relative bias^2 that no number of iterations removes, estimated pooled over 7 x 7 before it is
+// squared (PathTracingsBiasIsNotOneProbesFind). Where the budget is known it
 // is priced as a variance of bias^2 times the iterations path tracing would render (the same final
 // MSE): at 16 iterations the bias costs less than the light paths and merging cost, and the plan
 // path traces; at a million iterations it keeps light paths and merges in the block. Without a
 // budget the missed energy rules path tracing out (AnInfiniteVarianceIsCountedNotAveragedAway).
+// The relative bias^2 per pixel of a 0.1 that path tracing misses in the 4 x 4 block at (14..17,
+// 14..17) of a 32 x 32 image whose means are 1 there and 0.9 elsewhere, pooled before squaring:
+// the sum over pixels of (7 x 7 mean of the 0.1)^2 / (7 x 7 mean of mean^2 + 0.01), over 1024
+// (computed apart, with numpy). It is 0.256 of the per-pixel squares' 16 x 0.01 / 1.01 / 1024: a
+// caustic smaller than the window weighs less pooled.
+constexpr double kPooledBlockBias = 3.9613737e-05;
+
 TEST(AdaptiveVcm, PathTracingsBiasIsWeighedAgainstTheBudget) {
   const int w = 32, h = 32;
   for (const double budget : {16.0, 1e6}) {
@@ -352,8 +360,7 @@ TEST(AdaptiveVcm, PathTracingsBiasIsWeighedAgainstTheBudget) {
     plan.report(stats);
     const auto& last = stats["adaptive"]["history"].back();
     EXPECT_EQ(last["path_tracing_bias_iterations"].get<double>(), budget);
-    // 16 of 1024 pixels with (0.1)^2 / 1.01, pooled.
-    EXPECT_NEAR(last["path_tracing_relative_bias"].get<double>(), 16 * 0.01 / 1.01 / 1024, 1e-6);
+    EXPECT_NEAR(last["path_tracing_relative_bias"].get<double>(), kPooledBlockBias, 1e-9);
     const bidir::IterationPlan chosen = plan.plan(3);
     if (budget < 100) {
       EXPECT_EQ(chosen.light_paths, 0u);
@@ -363,6 +370,51 @@ TEST(AdaptiveVcm, PathTracingsBiasIsWeighedAgainstTheBudget) {
       EXPECT_EQ(last["candidates"][0]["pixels_missing_energy"].get<double>(), 0.0);
     }
   }
+}
+
+// The square of the missed energy's mean over K probes overestimates the square of the bias by
+// the mean's variance: energy that one probe found and the others did not is mostly that noise.
+// The plan estimates bias^2 from pairs of different probes instead (the mean of M_k M_l, M_k a
+// probe's missed energy pooled over 7 x 7), so a 0.3 that only the first of three probes found
+// in one block prices nothing (the plain square: 0.01 per pixel), while a 0.1 that every probe
+// found in another block prices its full pooled square, as in the test above.
+TEST(AdaptiveVcm, PathTracingsBiasIsNotOneProbesFind) {
+  const int w = 32, h = 32;
+  bidir::AdaptivePlan plan(w, h, /*measured_costs=*/false);
+  bidir::MisCounts counts;
+  counts.light_trace = float(w * h);
+  counts.connect = 2;
+  counts.merge = float(w * h) * 3.14159f * 0.01f * 0.01f;
+  bidir::TechniqueTerms merge_only;
+  merge_only.own = bidir::TechniqueClass::Merge;
+  auto in_block = [&](size_t p, size_t at) {
+    return p % w >= at && p % w < at + 4 && p / w >= at && p / w < at + 4;
+  };
+  for (int probe = 0; probe < 3; ++probe) {
+    plan.begin_probe(0.01f);
+    for (size_t p = 0; p < size_t(w * h); ++p) {
+      bidir::AdaptivePlan::CandidateSums sums = plan.pixel_start(p);
+      plan.add(sums, 0.9f, nullptr, counts);
+      if (in_block(p, 14)) plan.add(sums, 0.1f, &merge_only, counts);
+      if (probe == 0 && in_block(p, 2)) plan.add(sums, 0.3f, &merge_only, counts);
+      plan.pixel_end(p, sums);
+    }
+    bidir::ProbeWork work;
+    work.light_paths = w * h;
+    work.light_vertices = 2.0 * w * h;
+    work.camera_vertices = work.nondelta_camera_vertices = 2.0 * w * h;
+    work.connections = 4.0 * w * h;
+    work.merge_queries = 2.0 * w * h;
+    work.photons = 4.0 * w * h;
+    plan.set_budget(16, 0, 0);
+    std::vector<float> means(size_t(w * h));
+    for (size_t p = 0; p < means.size(); ++p) means[p] = in_block(p, 14) ? 1.f : 0.9f;
+    plan.finish_probe(work, means);
+  }
+  nlohmann::json stats;
+  plan.report(stats);
+  const auto& last = stats["adaptive"]["history"].back();
+  EXPECT_NEAR(last["path_tracing_relative_bias"].get<double>(), kPooledBlockBias, 1e-9);
 }
 
 // A pixel's variance estimate from a few probes, second moment minus the film's mean^2, is

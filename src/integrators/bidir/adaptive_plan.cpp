@@ -7,6 +7,7 @@
 
 #include "core/compact_float.h"
 #include "core/math.h"
+#include "integrators/bidir/grid_statistics.h"
 
 namespace caustica::bidir {
 
@@ -109,6 +110,8 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
   roulette_diff_.assign(grid_pixels_ * kCandidates * 3, 0);
   pixel_vertices_.assign(grid_pixels_, 0.f);
   pt_missing_.assign(grid_pixels_, 0.f);
+  probe_missing_.assign(grid_pixels_, 0.f);
+  pooled_missing_squares_.assign(grid_pixels_, 0.0);
   chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
   roulette_.fill(1.0);
 }
@@ -222,6 +225,7 @@ IterationPlan AdaptivePlan::plan(uint32_t iteration) const {
 }
 
 void AdaptivePlan::begin_probe(float radius) {
+  std::fill(probe_missing_.begin(), probe_missing_.end(), 0.f);
   light_sums_.assign(grid_pixels_ * kLightSums * kCandidates, to_bfloat16(0.f));
   light_missing_pt_.assign(grid_pixels_, 0.f);
   const std::vector<Candidate>& list = candidates();
@@ -323,6 +327,7 @@ void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums, double cam
   const size_t g = grid_index(pixel);
   pixel_vertices_[g] += float(camera_vertices);  // integers: exact far beyond any probe count
   pt_missing_[g] += sums.missing_pt;
+  probe_missing_[g] += sums.missing_pt;
   uint8_t* m = &moments_[g * kCandidates * 3];
   uint8_t* odd = probes_ % 2 == 1 ? &moments_odd_[g * kCandidates * 3] : nullptr;
   for (size_t j = 0; j < kCandidates; ++j) {
@@ -353,6 +358,11 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
                                 const std::vector<double>& measured, double iterations,
                                 double thread_seconds) {
   ++probes_;
+  {
+    std::vector<double> pooled(probe_missing_.begin(), probe_missing_.end());
+    pooled = box_blur(pooled, grid_w_, grid_h_, kPoolRadius);
+    for (size_t p = 0; p < grid_pixels_; ++p) pooled_missing_squares_[p] += pooled[p] * pooled[p];
+  }
   // The light-tracing sums (6 bytes per pixel and candidate) are only needed while a probe
   // renders; released before the choice, so that its buffers do not add to them.
   std::vector<uint16_t>().swap(light_sums_);

@@ -166,6 +166,7 @@ class AdaptivePlan {
   // (predicted) what everything before it did (schedule_next_probe): with one cost per
   // iteration, iterations 3, 7, 15, 31, ...
   static constexpr int kFirstProbes = 2;
+  static constexpr int kPoolRadius = 3;  // pixel statistics pooled over 7 x 7 (box_blur)
   // What recording every contribution for every candidate adds to a probe's pixels (measured on
   // cornell-caustics 160x160, 1 thread: a probe 399 ms against 224 ms for vcm --connections 2,
   // docs/adaptive-vcm.md "What a probe costs").
@@ -349,6 +350,12 @@ class AdaptivePlan {
   // light paths by 1.45x and 1.81x). A bright caustic's bias outweighs that; and as the budget
   // grows, so does the weight, so the choice converges to the unbiased one.
   std::vector<float> pt_missing_;
+  // This probe's part of pt_missing_ (zeroed by begin_probe), and per grid pixel the sum over
+  // the probes of the square of each probe's missed energy pooled over the pixel's 7 x 7 window
+  // (finish_probe): with pt_missing_ pooled the same way, the unbiased estimate of the pooled
+  // bias^2 (path_tracing_bias).
+  std::vector<float> probe_missing_;
+  std::vector<double> pooled_missing_squares_;
   // Per grid pixel, pooled as the variances are: what path tracing's bias adds to its variance
   // per iteration, the relative bias^2 times the weight that turns it into a per-iteration
   // variance, the iterations path tracing would render in the budget

@@ -308,6 +308,8 @@ TEST(AdaptiveVcm, AnInfiniteVarianceIsCountedNotAveragedAway) {
 // MSE): at 16 iterations the bias costs less than the light paths and merging cost, and the plan
 // path traces; at a million iterations it keeps light paths and merges in the block. Without a
 // budget the missed energy rules path tracing out (AnInfiniteVarianceIsCountedNotAveragedAway).
+namespace {
+
 // The relative bias^2 per pixel of a 0.1 that path tracing misses in the 4 x 4 block at (14..17,
 // 14..17) of a 32 x 32 image whose means are 1 there and 0.9 elsewhere, pooled before squaring:
 // the sum over pixels of (7 x 7 mean of the 0.1)^2 / (7 x 7 mean of mean^2 + 0.01), over 1024
@@ -315,15 +317,37 @@ TEST(AdaptiveVcm, AnInfiniteVarianceIsCountedNotAveragedAway) {
 // caustic smaller than the window weighs less pooled.
 constexpr double kPooledBlockBias = 3.9613737e-05;
 
+// What a probe of a w x h image did: one light path per pixel with vertices_per_path vertices
+// (and twice as many photons per query), two camera vertices and four connections per pixel.
+bidir::ProbeWork probe_work(int w, int h, double vertices_per_path) {
+  const double n = double(w) * h;
+  bidir::ProbeWork work;
+  work.light_paths = n;
+  work.light_vertices = vertices_per_path * n;
+  work.camera_vertices = work.nondelta_camera_vertices = 2.0 * n;
+  work.connections = 4.0 * n;
+  work.merge_queries = 2.0 * n;
+  work.photons = 2.0 * vertices_per_path * n;
+  return work;
+}
+
+// A probe's counts: one light path per pixel, two connections, merging at radius 0.01.
+bidir::MisCounts probe_counts(int w, int h) {
+  bidir::MisCounts counts;
+  counts.light_trace = float(w * h);
+  counts.connect = 2;
+  counts.merge = float(w * h) * 3.14159f * 0.01f * 0.01f;
+  return counts;
+}
+
+}  // namespace
+
 TEST(AdaptiveVcm, PathTracingsBiasIsWeighedAgainstTheBudget) {
   const int w = 32, h = 32;
   for (const double budget : {16.0, 1e6}) {
     SCOPED_TRACE(budget);
     bidir::AdaptivePlan plan(w, h, /*measured_costs=*/false);
-    bidir::MisCounts counts;  // a probe's: one light path per pixel, two connections, merging
-    counts.light_trace = float(w * h);
-    counts.connect = 2;
-    counts.merge = float(w * h) * 3.14159f * 0.01f * 0.01f;
+    const bidir::MisCounts counts = probe_counts(w, h);
     bidir::TechniqueTerms merge_only;
     merge_only.own = bidir::TechniqueClass::Merge;
     const float a = std::sqrt(3.f * 0.04f);
@@ -343,18 +367,11 @@ TEST(AdaptiveVcm, PathTracingsBiasIsWeighedAgainstTheBudget) {
         if (in_block(p)) plan.add(sums, 0.1f, &merge_only, counts);
         plan.pixel_end(p, sums);
       }
-      bidir::ProbeWork work;
-      work.light_paths = w * h;
-      // Long light paths: light paths cost more than path tracing does.
-      work.light_vertices = 12.0 * w * h;
-      work.camera_vertices = work.nondelta_camera_vertices = 2.0 * w * h;
-      work.connections = 4.0 * w * h;
-      work.merge_queries = 2.0 * w * h;
-      work.photons = 24.0 * w * h;
       plan.set_budget(budget, 0, 0);
       std::vector<float> means(size_t(w * h));
       for (size_t p = 0; p < means.size(); ++p) means[p] = in_block(p) ? 1.f : 0.9f;
-      plan.finish_probe(work, means);
+      // Long light paths: light paths cost more than path tracing does.
+      plan.finish_probe(probe_work(w, h, 12.0), means);
     }
     nlohmann::json stats;
     plan.report(stats);
@@ -381,10 +398,7 @@ TEST(AdaptiveVcm, PathTracingsBiasIsWeighedAgainstTheBudget) {
 TEST(AdaptiveVcm, PathTracingsBiasIsNotOneProbesFind) {
   const int w = 32, h = 32;
   bidir::AdaptivePlan plan(w, h, /*measured_costs=*/false);
-  bidir::MisCounts counts;
-  counts.light_trace = float(w * h);
-  counts.connect = 2;
-  counts.merge = float(w * h) * 3.14159f * 0.01f * 0.01f;
+  const bidir::MisCounts counts = probe_counts(w, h);
   bidir::TechniqueTerms merge_only;
   merge_only.own = bidir::TechniqueClass::Merge;
   auto in_block = [&](size_t p, size_t at) {
@@ -399,17 +413,10 @@ TEST(AdaptiveVcm, PathTracingsBiasIsNotOneProbesFind) {
       if (probe == 0 && in_block(p, 2)) plan.add(sums, 0.3f, &merge_only, counts);
       plan.pixel_end(p, sums);
     }
-    bidir::ProbeWork work;
-    work.light_paths = w * h;
-    work.light_vertices = 2.0 * w * h;
-    work.camera_vertices = work.nondelta_camera_vertices = 2.0 * w * h;
-    work.connections = 4.0 * w * h;
-    work.merge_queries = 2.0 * w * h;
-    work.photons = 4.0 * w * h;
     plan.set_budget(16, 0, 0);
     std::vector<float> means(size_t(w * h));
     for (size_t p = 0; p < means.size(); ++p) means[p] = in_block(p, 14) ? 1.f : 0.9f;
-    plan.finish_probe(work, means);
+    plan.finish_probe(probe_work(w, h, 2.0), means);
   }
   nlohmann::json stats;
   plan.report(stats);

@@ -300,14 +300,6 @@ TEST(AdaptiveVcm, AnInfiniteVarianceIsCountedNotAveragedAway) {
   EXPECT_EQ(pt["pixels_missing_energy"].get<double>(), 49.0);  // the 7 x 7 pooling window
 }
 
-// Energy that only light paths find (here a merge-only contribution of 0.1 in a 4 x 4 block,
-// on top of a noisy estimate of 0.9 that every candidate makes) is path tracing's bias there:
-// relative bias^2 that no number of iterations removes, estimated pooled over 7 x 7 before it is
-// squared (PathTracingsBiasIsNotOneProbesFind). Where the budget is known it
-// is priced as a variance of bias^2 times the iterations path tracing would render (the same final
-// MSE): at 16 iterations the bias costs less than the light paths and merging cost, and the plan
-// path traces; at a million iterations it keeps light paths and merges in the block. Without a
-// budget the missed energy rules path tracing out (AnInfiniteVarianceIsCountedNotAveragedAway).
 namespace {
 
 // The relative bias^2 per pixel of a 0.1 that path tracing misses in the 4 x 4 block at (14..17,
@@ -342,6 +334,14 @@ bidir::MisCounts probe_counts(int w, int h) {
 
 }  // namespace
 
+// Energy that only light paths find (here a merge-only contribution of 0.1 in a 4 x 4 block,
+// on top of a noisy estimate of 0.9 that every candidate makes) is path tracing's bias there:
+// relative bias^2 that no number of iterations removes, estimated pooled over 7 x 7 before it is
+// squared (PathTracingsBiasIsNotOneProbesFind). Where the budget is known it is priced as a
+// variance of bias^2 times the iterations path tracing would render (the same final MSE): at 16
+// iterations the bias costs less than the light paths and merging cost, and the plan path
+// traces; at a million iterations it keeps light paths and merges in the block. Without a budget
+// the missed energy rules path tracing out (AnInfiniteVarianceIsCountedNotAveragedAway).
 TEST(AdaptiveVcm, PathTracingsBiasIsWeighedAgainstTheBudget) {
   const int w = 32, h = 32;
   for (const double budget : {16.0, 1e6}) {

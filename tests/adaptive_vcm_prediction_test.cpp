@@ -424,6 +424,54 @@ TEST(AdaptiveVcm, PathTracingsBiasIsNotOneProbesFind) {
   EXPECT_NEAR(last["path_tracing_relative_bias"].get<double>(), kPooledBlockBias, 1e-9);
 }
 
+// With a budget in seconds the probes' share is also bounded in the seconds they took: the fixed
+// model prices a probe at 0.5-0.9x of what it takes beside the choice it replaces, and the probes
+// took 10-34% of 20 s at the scenes' own resolutions under a bound of 10% in the model's units.
+// Three probes of the same samples and a 12 s budget, 1 s spent by the third: where the probes
+// took 0.1 s each and the iterations between them 0.7 s, a fourth probe comes; where they took
+// 0.33 s each (0.99 s beyond the chosen iterations' 0.01 s; with the next one 1.32 s, over 10% of
+// 12 s), none does, though the model's prices alone would allow it. At a fixed --spp the same
+// seconds are not read (the probes must not depend on timing).
+TEST(AdaptiveVcm, ProbesShareIsBoundedInTheSecondsTheyTookWithATimeBudget) {
+  const int w = 32, h = 32;
+  struct Case {
+    double spp, seconds, probe, segment;
+    bool next;
+  };
+  for (const Case c : {Case{0, 12, 0.1, 0.7, true}, Case{0, 12, 0.33, 0.01, false},
+                       Case{1e6, 0, 0.33, 0.01, true}}) {
+    SCOPED_TRACE(testing::Message() << c.spp << " spp, " << c.probe << " s per probe");
+    bidir::AdaptivePlan plan(w, h, /*measured_costs=*/false);
+    const bidir::MisCounts counts = probe_counts(w, h);
+    uint64_t segment = 0;  // the chosen iterations between the second probe and the third
+    for (int probe = 0; probe < 3; ++probe) {
+      plan.begin_probe(0.01f);
+      for (size_t p = 0; p < size_t(w * h); ++p) {
+        bidir::AdaptivePlan::CandidateSums sums = plan.pixel_start(p);
+        plan.add(sums, 0.5f + 0.1f * float((p * 7 + size_t(probe) * 3) % 5), nullptr, counts);
+        plan.pixel_end(p, sums);
+      }
+      const double probes_seconds = (probe + 1) * c.probe;
+      const double segment_seconds = probe == 2 ? c.segment : 0.0;
+      plan.set_budget(c.spp, c.seconds, probes_seconds + segment_seconds);
+      plan.set_times(probes_seconds, segment_seconds, probe == 2 ? double(segment) : 0.0);
+      plan.finish_probe(probe_work(w, h, 2.0), std::vector<float>(size_t(w * h), 0.7f));
+      if (probe == 0) continue;  // the first choice comes after the second probe
+      nlohmann::json stats;
+      plan.report(stats);
+      const auto& next = stats["adaptive"]["history"].back()["next_probe"];
+      ASSERT_EQ(stats["adaptive"]["history"].back()["after_probe"].get<int>(), probe + 1);
+      if (probe == 1) {
+        ASSERT_FALSE(next.is_null());
+        segment = next.get<uint64_t>() - 2;
+        ASSERT_GT(segment, 0u);
+      } else if (probe == 2) {
+        EXPECT_EQ(!next.is_null(), c.next);
+      }
+    }
+  }
+}
+
 // A pixel's variance estimate from a few probes, second moment minus the film's mean^2, is
 // noisy and often negative where the variance is small beside mean^2. Clamped at zero pixel by
 // pixel it was biased up by the noise: on point-room (160 x 120, 64 iterations, 7 probes) one

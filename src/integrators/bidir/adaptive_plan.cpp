@@ -134,6 +134,7 @@ bool AdaptivePlan::is_probe(uint32_t iteration) const {
 void AdaptivePlan::schedule_next_probe() {
   const uint64_t probe = probes_ <= kFirstProbes ? uint64_t(probes_ - 1) : next_probe_;
   const double choice = chosen_cost_, probe_cost = probe_cost_;
+  const double segment_choice = last_choice_cost_;  // the choice the last segment rendered
   // The predicted cost of the iterations up to this probe (those since the last probe at the
   // choice they rendered, and this probe; before the first choice every iteration was a
   // probe), and of what the probes cost beyond the choice they stood in for: their samples are
@@ -162,8 +163,9 @@ void AdaptivePlan::schedule_next_probe() {
     // predicted cost (the rest of the budget at this choice): at 3, 7, 15, ... they took 22-35%
     // of 20 s at the scenes' own resolutions where the choice was cheap.
     const double rest = remaining_cost(probe, choice);
-    if (std::isfinite(rest) &&
-        probe_excess_ + std::max(0.0, probe_cost - choice) > kMaxProbeShare * (spent_cost_ + rest))
+    if ((std::isfinite(rest) && probe_excess_ + std::max(0.0, probe_cost - choice) >
+                                    kMaxProbeShare * (spent_cost_ + rest)) ||
+        probe_seconds_exceed_share(choice, segment_choice, probe_cost))
       gap = std::numeric_limits<uint32_t>::max();
   }
   next_probe_ = probe + 1 + gap;
@@ -177,6 +179,25 @@ void AdaptivePlan::set_budget(double iterations, double seconds, double elapsed)
   budget_iterations_ = iterations;
   budget_seconds_ = seconds;
   elapsed_seconds_ = elapsed;
+}
+
+void AdaptivePlan::set_times(double probe_seconds, double segment_seconds,
+                             double segment_iterations) {
+  last_probe_seconds_ = probe_seconds - probe_seconds_;
+  probe_seconds_ = probe_seconds;
+  segment_iteration_seconds_ = segment_iterations > 0 ? segment_seconds / segment_iterations : 0;
+}
+
+bool AdaptivePlan::probe_seconds_exceed_share(double choice, double segment_choice,
+                                              double probe_cost) const {
+  if (!(budget_seconds_ > 0) || !(last_probe_seconds_ > 0) || !(choice > 0) || !(probe_cost > 0))
+    return false;
+  const double iteration = segment_iteration_seconds_ > 0 && segment_choice > 0
+                               ? segment_iteration_seconds_ * choice / segment_choice
+                               : last_probe_seconds_ * choice / probe_cost;
+  const double excess = std::max(0.0, probe_seconds_ - double(probes_) * iteration);
+  const double next = std::max(0.0, last_probe_seconds_ - iteration);
+  return excess + next > kMaxProbeShare * budget_seconds_;
 }
 
 double AdaptivePlan::remaining_cost(uint64_t probe, double choice) const {

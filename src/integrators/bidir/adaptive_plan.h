@@ -36,21 +36,21 @@
 // (predicted by the fixed model) what everything before it did, so their cost fades as the
 // render grows (with one cost per iteration: 3, 7, 15, 31, ...), and none that would take the
 // probes beyond kMaxProbeShare of the budget's predicted time in excess of the choice they stand
-// in for (schedule_next_probe). On an image of more than kProbePixels pixels a probe records one
-// pixel per block of the image and the estimates below are of that grid of pixels; the others
-// render the last choice (IterationPlan::records), with its light paths (kSparseProbeLightPaths to
-// one per pixel) once there is one. The first choice is made after the second probe; the variance
-// all candidates share is winsorised at its 99.5th percentile over the pixels (a shared firefly
-// must not decide) and pooled over 7 x 7 neighbours before the per-pixel decision (a handful of
-// samples per pixel would otherwise decide by luck; an infinite variance makes its whole window
-// infinite). Iterations and pixels that path trace (and are not probes) are rendered by pt's own
-// estimator (path_tracer.h, power heuristic unless --mis says otherwise), cheaper than the core's
-// camera subpaths, and no light-tracing splat lands in such a pixel; the cost model prices their
-// camera vertices separately. Every iteration, probe or not, is an unbiased (consistent, when
-// merging) estimate of the same image, and the film averages them. Deterministic at fixed spp and
-// seed for any thread count unless measured costs are asked for, and for any number of MPI ranks:
-// every rank renders every probe, normalised by the film of all ranks
-// (Integrator::shared_iteration).
+// in for (schedule_next_probe; with --time also of the seconds they took, set_times). On an image
+// of more than kProbePixels pixels a probe records one pixel per block of the image and the
+// estimates below are of that grid of pixels; the others render the last choice
+// (IterationPlan::records), with its light paths (kSparseProbeLightPaths to one per pixel) once
+// there is one. The first choice is made after the second probe; the variance all candidates share
+// is winsorised at its 99.5th percentile over the pixels (a shared firefly must not decide) and
+// pooled over 7 x 7 neighbours before the per-pixel decision (a handful of samples per pixel would
+// otherwise decide by luck; an infinite variance makes its whole window infinite). Iterations and
+// pixels that path trace (and are not probes) are rendered by pt's own estimator (path_tracer.h,
+// power heuristic unless --mis says otherwise), cheaper than the core's camera subpaths, and no
+// light-tracing splat lands in such a pixel; the cost model prices their camera vertices
+// separately. Every iteration, probe or not, is an unbiased (consistent, when merging) estimate of
+// the same image, and the film averages them. Deterministic at fixed spp and seed for any thread
+// count unless measured costs are asked for, and for any number of MPI ranks: every rank renders
+// every probe, normalised by the film of all ranks (Integrator::shared_iteration).
 #pragma once
 
 #include <algorithm>
@@ -180,6 +180,16 @@ class AdaptivePlan {
   // (--time) with the seconds spent so far; 0 where unknown. The probes' share of the time is
   // bounded by what the budget predicts (schedule_next_probe).
   void set_budget(double iterations, double seconds, double elapsed);
+  // Before each probe is finished, with --time: the wall seconds of every probe so far (this
+  // one included) and of the `iterations` iterations since the last probe (the last choice's).
+  // The fixed model under-prices a probe beside the choice it replaces (the 14 scenes at their
+  // own resolutions, 20 s, commit bb375eb: measured / predicted ratio of a probe's time to a
+  // chosen iteration's 1.1-2.0 on 12 of them, water-caustic 0.95, sun-glass 3.0), so the probes
+  // took 3-34% of a 20 s budget (median 15%) under a bound of kMaxProbeShare in the model's
+  // units; with a budget in seconds the bound is also applied to these seconds
+  // (probe_seconds_exceed_share). Not with --spp, whose probes must not depend on timing
+  // (bit-identical images).
+  void set_times(double probe_seconds, double segment_seconds, double segment_iterations);
   IterationPlan plan(uint32_t iteration) const;
 
   // Recording a probe. A pixel's estimate in a probe is the sum of its contributions F_i, each
@@ -289,6 +299,12 @@ class AdaptivePlan {
   // The predicted cost of the budget's iterations after the probe at `probe` at cost `choice`
   // (infinite without a budget).
   double remaining_cost(uint64_t probe, double choice) const;
+  // With a budget in seconds: whether another probe would take the probes' seconds beyond
+  // kMaxProbeShare of it, in excess of the iterations of the choice (predicted cost `choice`)
+  // that they stand in for. A chosen iteration's seconds are those the last segment took,
+  // scaled by the model from its choice (predicted cost `segment_choice`) to this one, or
+  // before any segment the last probe's at the model's ratio (`probe_cost`).
+  bool probe_seconds_exceed_share(double choice, double segment_choice, double probe_cost) const;
   // Reports the last choice's measured and predicted relative variances (finish_probe).
   void check_last_choice(const std::vector<double>& measured, double iterations,
                          double thread_seconds, const std::vector<float>& means);
@@ -397,7 +413,10 @@ class AdaptivePlan {
   double spent_cost_ = 0, last_choice_cost_ = 0, probe_excess_ = 0;
   double probe_cost_ = 0;  // a probe's predicted microseconds per pixel (choose)
   double budget_iterations_ = 0, budget_seconds_ = 0, elapsed_seconds_ = 0;  // set_budget
-  ProbeWork work_;                                                           // summed over probes
+  // set_times: the probes' wall seconds, the last probe's, and the last segment's per iteration
+  // (0: no iteration since the previous probe).
+  double probe_seconds_ = 0, last_probe_seconds_ = 0, segment_iteration_seconds_ = 0;
+  ProbeWork work_;  // summed over probes
   std::vector<PixelMode> modes_;
   IterationPlan chosen_;
   // The last choice: its candidate (the index of its entry without merging; 0: path tracing;

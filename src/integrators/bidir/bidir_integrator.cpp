@@ -96,7 +96,11 @@ void BidirIntegrator::prepare(const Scene& scene, Film& film) {
                          settings_.bidir.force_pixel_mode);
   if (tech_.adaptive && !techniques_.enabled())
     path_tracer_ = std::make_unique<PathTracer>(settings_);
-  if (tech_.adaptive) segment_.reset(film.pixel_count());
+  if (tech_.adaptive) {
+    segment_.reset(film.pixel_count());
+    segment_thread_seconds_ = segment_seconds_ = 0;
+    segment_iterations_ = 0;
+  }
 }
 
 void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, Film& film) {
@@ -199,8 +203,11 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
       work.camera_seconds = seconds_since(camera_start);
     plan_.set_budget(std::max(0, budget_spp()), budget_seconds(),
                      seconds_total_ + seconds_since(start));
+    plan_.set_times(probe_seconds_total_ + seconds_since(start), segment_seconds_,
+                    segment_iterations_);
     plan_.finish_probe(work, means_before, measured, measured_iterations, segment_thread_seconds_);
-    segment_thread_seconds_ = 0;
+    segment_thread_seconds_ = segment_seconds_ = 0;
+    segment_iterations_ = 0;
   } else if (tech_.adaptive) {
     segment_.end_iteration(film);
   }
@@ -212,8 +219,11 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   seconds_total_ += seconds;
   if (it.plan.probe) probe_seconds_total_ += seconds;
-  if (tech_.adaptive && !it.plan.probe)
+  if (tech_.adaptive && !it.plan.probe) {
     segment_thread_seconds_ += seconds * double(tbb::this_task_arena::max_concurrency());
+    segment_seconds_ += seconds;
+    ++segment_iterations_;
+  }
 }
 
 void BidirIntegrator::finish(const Scene& scene, Film& film) {

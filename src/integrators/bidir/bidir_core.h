@@ -354,9 +354,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
   // adaptive-vcm: thread-seconds of the iterations since the last probe (the last choice's), for
   // the plan's check of its predicted cost.
   double segment_thread_seconds_ = 0;
-  // adaptive-vcm with --time: wall seconds and count of those iterations, for the probes'
+  // adaptive-vcm with --time: how many iterations those were on this rank, for the probes'
   // measured share of the budget (AdaptivePlan::set_times).
-  double segment_seconds_ = 0;
   uint32_t segment_iterations_ = 0;
   ProbeWork work_total_;  // operations counted over all iterations (counts only)
   std::vector<std::string> technique_files_;

@@ -98,7 +98,7 @@ void BidirIntegrator::prepare(const Scene& scene, Film& film) {
     path_tracer_ = std::make_unique<PathTracer>(settings_);
   if (tech_.adaptive) {
     segment_.reset(film.pixel_count());
-    segment_thread_seconds_ = segment_seconds_ = 0;
+    segment_thread_seconds_ = 0;
     segment_iterations_ = 0;
   }
 }
@@ -203,10 +203,11 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
       work.camera_seconds = seconds_since(camera_start);
     plan_.set_budget(std::max(0, budget_spp()), budget_seconds(),
                      seconds_total_ + seconds_since(start));
-    plan_.set_times(probe_seconds_total_ + seconds_since(start), segment_seconds_,
+    plan_.set_times(probe_seconds_total_ + seconds_since(start),
+                    segment_thread_seconds_ / double(tbb::this_task_arena::max_concurrency()),
                     segment_iterations_);
     plan_.finish_probe(work, means_before, measured, measured_iterations, segment_thread_seconds_);
-    segment_thread_seconds_ = segment_seconds_ = 0;
+    segment_thread_seconds_ = 0;
     segment_iterations_ = 0;
   } else if (tech_.adaptive) {
     segment_.end_iteration(film);
@@ -221,7 +222,6 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   if (it.plan.probe) probe_seconds_total_ += seconds;
   if (tech_.adaptive && !it.plan.probe) {
     segment_thread_seconds_ += seconds * double(tbb::this_task_arena::max_concurrency());
-    segment_seconds_ += seconds;
     ++segment_iterations_;
   }
 }

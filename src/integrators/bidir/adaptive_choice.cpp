@@ -19,8 +19,7 @@
 namespace caustica::bidir {
 
 namespace {
-constexpr double kRelEps = 0.01;                        // as the relMSE metric (image/metrics.h)
-constexpr int kBlurRadius = AdaptivePlan::kPoolRadius;  // 7 x 7
+constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
 constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
 // Path tracing is kept unless another configuration's predicted relVar x time is lower by more
 // than this factor. The cost model has no term for the per-iteration costs of light paths (their
@@ -220,7 +219,7 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
   std::vector<double> relative(grid_pixels_);
   for (size_t p = 0; p < grid_pixels_; ++p)
     relative[p] = measured[p] / (double(means[p]) * means[p] + kRelEps);
-  relative = box_blur(relative, grid_w_, grid_h_, kBlurRadius);
+  relative = box_blur(relative, grid_w_, grid_h_, kPoolRadius);
   const double cap = finite_quantile(chosen_variance_, kWinsorize);
   std::vector<std::array<double, 2>> blocks((grid_pixels_ + kPixelBlock - 1) / kPixelBlock);
   for_pixel_blocks(grid_pixels_, [&](size_t b, size_t begin, size_t end) {
@@ -281,10 +280,10 @@ std::vector<double> AdaptivePlan::path_tracing_bias(const std::vector<float>& me
   // and the plain square stands.
   const double k = double(probes_);
   std::vector<double> sum(pt_missing_.begin(), pt_missing_.end());
-  sum = box_blur(sum, grid_w_, grid_h_, kBlurRadius);  // sum over probes of M_k
+  sum = box_blur(sum, grid_w_, grid_h_, kPoolRadius);  // sum over probes of M_k
   std::vector<double> norm(grid_pixels_);
   for (size_t p = 0; p < grid_pixels_; ++p) norm[p] = double(means[p]) * means[p] + kRelEps;
-  norm = box_blur(norm, grid_w_, grid_h_, kBlurRadius);
+  norm = box_blur(norm, grid_w_, grid_h_, kPoolRadius);
   std::vector<double> bias(grid_pixels_);
   for (size_t p = 0; p < grid_pixels_; ++p) {
     const double square = k >= 2 ? (sum[p] * sum[p] - pooled_missing_squares_[p]) / (k * (k - 1))
@@ -298,7 +297,7 @@ std::vector<double> AdaptivePlan::path_tracing_bias(const std::vector<float>& me
   }
   // Ruled out wherever a probe saw it miss energy, pooled as an infinite variance would be.
   for (size_t p = 0; p < grid_pixels_; ++p) bias[p] = pt_missing_[p] != 0 ? 1.0 : 0.0;
-  bias = box_blur(bias, grid_w_, grid_h_, kBlurRadius);
+  bias = box_blur(bias, grid_w_, grid_h_, kPoolRadius);
   for (double& x : bias) x = x > 0 ? std::numeric_limits<double>::infinity() : 0.0;
   return bias;
 }
@@ -391,7 +390,7 @@ std::vector<double> AdaptivePlan::relative_variances(
     for (size_t p = begin; p < end; ++p)
       v[p] = relative_variance(p, j, means, half) + correction[p];
   });
-  v = box_blur(v, grid_w_, grid_h_, kBlurRadius);
+  v = box_blur(v, grid_w_, grid_h_, kPoolRadius);
   for (double& x : v) x = std::max(x, 0.0);  // inf stays inf
   if (pooled_extra)
     for (size_t p = 0; p < grid_pixels_; ++p) v[p] += (*pooled_extra)[p];
@@ -401,7 +400,7 @@ std::vector<double> AdaptivePlan::relative_variances(
 std::vector<double> AdaptivePlan::pixel_cost_weights() const {
   std::vector<double> w(grid_pixels_);
   for (size_t p = 0; p < grid_pixels_; ++p) w[p] = double(pixel_vertices_[p]);
-  w = box_blur(w, grid_w_, grid_h_, kBlurRadius);
+  w = box_blur(w, grid_w_, grid_h_, kPoolRadius);
   const double mean = finite_sum(grid_pixels_, [&](size_t p) { return w[p]; }) /
                       std::max(double(grid_pixels_), 1.0);
   for (double& x : w) x = mean > 0 ? x / mean : 1.0;

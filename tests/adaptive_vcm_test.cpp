@@ -122,7 +122,10 @@ TEST(AdaptiveVcm, KeepsMergingForCausticsAndReportsWhy) {
   ASSERT_FALSE(a["history"].empty());
   EXPECT_EQ(a["probes"].get<size_t>(), 1 + a["probe_iterations"].size());  // 0, and those
   EXPECT_GT(a["light_paths_per_iteration"].get<uint64_t>(), 0u);
-  EXPECT_GT(a["merge_fraction"].get<double>(), 0.02);
+  // 2.4% of the pixels with one light path per pixel; 1.2% (a block on the glass sphere's lower
+  // half, which shows the floor and its caustic through the glass) with the two light paths
+  // chosen since the roulette factor is a mean over pixels.
+  EXPECT_GT(a["merge_fraction"].get<double>(), 0.005);
   EXPECT_LT(a["merge_fraction"].get<double>(), 1.0);
   const auto& mask = a["merge_mask"];
   EXPECT_EQ(mask["width"].get<int>() * mask["block"].get<int>(), 48);

@@ -344,9 +344,10 @@ class AdaptivePlan {
   // own techniques, G_i^2 (n'_t / n_t), estimate its diagonal without that error, but only
   // from the samples of those techniques (a heavy tail where they are poor). So per pixel and
   // candidate this keeps their difference from the proxy (float24, as moments_), and each
-  // choice scales candidate j's relative variances by roulette_[j] = 1 + (the image's sum of
-  // that difference, relative) / (the image's sum of its relative variances), at least 1:
-  // the proxy's spatial detail, the own techniques' total.
+  // choice scales candidate j's relative variances by roulette_[j] = 1 + the mean over the
+  // pixels of that difference over the relative variance, both pooled over 7 x 7 and the ratio
+  // at least -1, the factor at least 1: the proxy's spatial detail, the own techniques' level
+  // (update_roulette_factors).
   std::vector<uint8_t> roulette_diff_;
   // Per grid pixel: its camera vertices summed over the probes. The camera-vertex parts of a
   // mode's price scale per pixel with them (relative to the image's mean, pooled as the

@@ -361,7 +361,7 @@ void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
     if (ratio.empty()) return;
     const double cap = finite_quantile(ratio, kWinsorize);
     double sum = 0;
-    for (double r : ratio) sum += std::clamp(r, -1.0, cap);
+    for (double r : ratio) sum += std::max(-1.0, std::min(r, cap));  // cap may lie below -1
     const double factor = 1.0 + sum / double(ratio.size());
     roulette_[j] = std::isfinite(factor) ? std::max(factor, 1.0) : 1.0;
   });

@@ -167,10 +167,11 @@ std::vector<std::string> integrator_list(const py::handle& integrators) {
 
 py::object compare(const LoadedScene& s, const py::object& integrators, const py::object& time,
                    const py::object& reference_array, const py::object& threads,
-                   const py::object& seed, const py::kwargs& options) {
+                   const py::object& seed, const py::object& runs, const py::kwargs& options) {
   ComparisonConfig config;
   config.integrators = integrator_list(integrators);
   config.seconds = number_arg("time", time, 0, cli::kMaxSeconds, true);
+  config.runs = int(integer_arg("runs", runs, 1, 1000));
   config.settings = integrator_settings(
       s, unsigned_arg("seed", seed, 0, std::numeric_limits<uint64_t>::max()), options);
   config.threads = thread_count(threads);
@@ -260,11 +261,16 @@ void add_render_functions(py::module_& m) {
 
   m.def("compare", &compare, py::arg("scene"), py::arg("integrators"), py::arg("time"),
         py::arg("reference") = py::none(), py::arg("threads") = 0, py::arg("seed") = 0,
-        "compare(scene, integrators, time, reference=None, threads=0, seed=0, **options) -> dict"
+        py::arg("runs") = 1,
+        "compare(scene, integrators, time, reference=None, threads=0, seed=0, runs=1, **options) "
+        "-> dict"
         "\n\nEqual-time comparison as `caustica compare`: each integrator (a list of names, or "
         "'pt,vcm') renders for `time` seconds, and its errors against the reference are taken "
         "at 1, 2, 4, ... s and at the end. reference: an array of the scene's size, or None to "
-        "render one first with vcm for 4x time (seed + 7919), as the command line does. options "
+        "render one first with vcm for 4x time (seed + 7919), as the command line does. runs: "
+        "1..1000 runs per integrator with seeds seed, seed + 1, ..., taking turns (as --runs); "
+        "each integrator's summary row and run are then its median run by relMSE, with every "
+        "run's errors in the row's relmse_runs and the run's repeats. options "
         "as for render(). Returns the content of the report's results.json: scene, "
         "seconds_per_integrator, threads, reference, interrupted, summary (final errors and "
         "speed-up vs pt per integrator) and runs (every snapshot). Ctrl-C raises "

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The markdown table of scripts/equal_time_table.sh: per scene, relMSE / trimmed relMSE of each
 integrator (the best fixed one in bold), adaptive-vcm over the best fixed one, what adaptive-vcm
-chose after its last probe, and the iterations of vcm and adaptive-vcm.
+chose after its last probe, and the iterations of vcm and adaptive-vcm. With several runs per
+integrator (RUNS=N) every figure is of each integrator's median run by relMSE.
 
     equal_time_summary.py OUT SCENE...
 """

@@ -8,6 +8,8 @@
 # RESOLUTION: small (default: 160 pixels wide, the resolutions listed below) or native (each
 # scene's own Film resolution: 2-16x the pixels, so fewer iterations and fewer probes in the
 # same time).
+# RUNS=N in the environment: N runs per integrator (compare --runs; seeds 0 to N - 1, the
+# integrators taking turns), each cell then the median run's; N times as long.
 # References already in OUT/refs are kept (delete them after a change to the integrators'
 # images). Run it on an otherwise idle machine: the compare runs are timed.
 set -euo pipefail
@@ -74,7 +76,8 @@ for s in "${scenes[@]}"; do
   echo "compare $name" >&2
   # shellcheck disable=SC2046
   "$bin" compare "$root/$file" $(resolution_of "$res") --time "$seconds" --threads 2 --seed 0 \
-    --integrators "$integrators" --reference "$out/refs/$name.exr" --out "$out/$name" \
+    --runs "${RUNS:-1}" --integrators "$integrators" --reference "$out/refs/$name.exr" \
+    --out "$out/$name" \
     >"$out/$name.log" 2>&1
 done
 

@@ -101,3 +101,42 @@ TEST(Cli, ReferenceDoesNotShareTheSeedOfTheRunsItJudges) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("was rendered with seed"), std::string::npos) << r.err;
 }
+
+// `compare --runs 3`: every integrator renders with seeds --seed .. --seed + 2, taking turns;
+// results.json lists every run's relMSE beside the median run's errors, runs.csv every run with
+// the shown one marked; a reference whose seed is one of the runs' is warned about.
+TEST(Cli, CompareWithSeveralRunsReportsEveryRunAndTheMedian) {
+  const fs::path d = fresh_dir("compare_runs");
+  CliRun r =
+      run("reference cornell --time 0.3 --resolution 16x12 --integrator pt --outfile ref", d);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string compare =
+      "compare cornell --time 0.15 --resolution 16x12 --integrators pt,pt --reference ref.exr "
+      "--threads 1 --runs 3 --out ";
+  r = run(compare + "c --seed 10", d);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  std::ifstream f(d / "c" / "results.json");
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["runs_per_integrator"], 3);
+  ASSERT_EQ(j["summary"].size(), 2u);
+  for (const auto& row : j["summary"]) {
+    EXPECT_EQ(row["seeds"], nlohmann::json({10, 11, 12}));
+    EXPECT_EQ(row["errors"]["relmse"], row["relmse_median"]);
+  }
+  std::ifstream csv(d / "c" / "runs.csv");
+  std::string line;
+  int lines = 0, shown = 0;
+  while (std::getline(csv, line))
+    if (lines++ > 0) shown += line.back() == '1';
+  EXPECT_EQ(lines, 7);  // the header and 2 x 3 runs
+  EXPECT_EQ(shown, 2);
+  // The reference's seed 7919 is the second run's of --seed 7918.
+  r = run(compare + "c2 --seed 7918", d);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("was rendered with seed 7919"), std::string::npos) << r.err;
+  r = run("compare cornell --time 0.1 --resolution 16x12 --reference ref.exr --runs 0 --out c3", d);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--runs"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "c3"));
+}

@@ -44,6 +44,9 @@ namespace {
 // they are (measured on cornell-box 160x160, 20 s runs against 60 s vcm references: bpt's relMSE
 // 0.000148 against the seed-0 reference and 0.000733 against an independent one, 5x too low).
 constexpr uint64_t kReferenceSeedOffset = 7919;
+// The most runs per integrator: below kReferenceSeedOffset, so that the runs' seeds never reach
+// the seed of a reference compare renders itself.
+constexpr int kMaxCompareRuns = 1000;
 
 struct ReferenceOptions : SharedOptions {
   ReferenceOptions() { seed = kReferenceSeedOffset; }
@@ -128,14 +131,36 @@ std::optional<uint64_t> reference_seed(const std::string& reference) {
   return std::nullopt;  // unreadable metadata says nothing: the reference itself was checked
 }
 
-void warn_if_reference_shares_seed(const std::string& reference, uint64_t seed) {
+// runs: the runs use seeds seed, seed + 1, ..., seed + runs - 1.
+void warn_if_reference_shares_seed(const std::string& reference, uint64_t seed, int runs) {
   const std::optional<uint64_t> ref_seed = reference_seed(reference);
-  if (!ref_seed || *ref_seed != seed) return;
+  if (!ref_seed || *ref_seed - seed >= uint64_t(runs)) return;  // unsigned: also below seed
   std::fprintf(stderr,
-               "compare: warning: %s was rendered with seed %llu, the seed of these runs: "
+               "compare: warning: %s was rendered with seed %llu, a seed of these runs: "
                "integrators that sample like the reference's share its noise and their errors "
                "are underestimated; pass another --seed here or to `caustica reference`\n",
-               excerpt(reference).c_str(), static_cast<unsigned long long>(seed));
+               excerpt(reference).c_str(), static_cast<unsigned long long>(*ref_seed));
+}
+
+// The summary on stdout, one line per integrator; with several runs its errors are the median
+// run's, and the least and largest relMSE of its runs follow.
+void print_summary(const nlohmann::json& summary, int runs) {
+  std::printf("%-12s %10s %8s %12s %12s %8s %10s%s\n", "", "iterations", "Mrays/s",
+              runs > 1 ? "relMSE(med)" : "relMSE", "relMSE-trim", "SSIM", "vs pt",
+              runs > 1 ? "   relMSE min - max (runs)" : "");
+  for (const auto& row : summary) {
+    const auto& e = row["errors"];
+    const bool has = row.contains("speedup_vs_pt") && row["speedup_vs_pt"].is_number();
+    std::printf("%-12s %10u %8.2f %12.4g %12.4g %8.4f %9.2fx",
+                row["integrator"].get<std::string>().c_str(), row["iterations"].get<uint32_t>(),
+                row["rays_per_second"].get<double>() * 1e-6, e["relmse"].get<double>(),
+                e["relmse_trimmed"].get<double>(), e["ssim"].get<double>(),
+                has ? row["speedup_vs_pt"].get<double>() : 0.0);
+    if (row.contains("relmse_min"))
+      std::printf("   %.4g - %.4g (%zu)", row["relmse_min"].get<double>(),
+                  row["relmse_max"].get<double>(), row["runs"].get<size_t>());
+    std::printf("\n");
+  }
 }
 
 struct CompareOptions : SharedOptions {
@@ -144,6 +169,7 @@ struct CompareOptions : SharedOptions {
   std::string out_dir;
   std::string reference_integrator = "";
   double reference_seconds = 0;
+  int runs = 1;
 };
 
 int run_compare(const CompareOptions& o, const CheckedOptions& checks, Ranks& ranks) {
@@ -207,7 +233,7 @@ int run_compare(const CompareOptions& o, const CheckedOptions& checks, Ranks& ra
   std::string ref_description;
   if (!o.reference.empty()) {
     ref_description = o.reference;
-    warn_if_reference_shares_seed(o.reference, settings.seed);
+    warn_if_reference_shares_seed(o.reference, settings.seed, o.runs);
   } else {
     // No reference given: render one first, 4x the per-integrator time, with the most robust
     // integrator available.
@@ -245,6 +271,7 @@ int run_compare(const CompareOptions& o, const CheckedOptions& checks, Ranks& ra
   ComparisonConfig config;
   config.integrators = names;
   config.seconds = o.seconds;
+  config.runs = o.runs;
   config.threads = threads;
   config.settings = settings;
   config.stop = stop_flag();
@@ -252,7 +279,7 @@ int run_compare(const CompareOptions& o, const CheckedOptions& checks, Ranks& ra
   ComparisonResult result =
       run_comparison(*scene, reference, config, [&](double f, const std::string& name) {
         (void)name;
-        bar.update(f, f * config.seconds * names.size(), "s rendered");
+        bar.update(f, f * config.seconds * double(names.size()) * config.runs, "s rendered");
       });
   bar.finish();
   if (result.runs.empty()) {
@@ -265,17 +292,7 @@ int run_compare(const CompareOptions& o, const CheckedOptions& checks, Ranks& ra
     FileSection writing;
     write_comparison_report(result, reference, dir);
   }
-  std::printf("%-12s %10s %8s %12s %12s %8s %10s\n", "", "iterations", "Mrays/s", "relMSE",
-              "relMSE-trim", "SSIM", "vs pt");
-  for (const auto& row : comparison_summary(result)) {
-    const auto& e = row["errors"];
-    const bool has = row.contains("speedup_vs_pt") && row["speedup_vs_pt"].is_number();
-    std::printf("%-12s %10u %8.2f %12.4g %12.4g %8.4f %9.2fx\n",
-                row["integrator"].get<std::string>().c_str(), row["iterations"].get<uint32_t>(),
-                row["rays_per_second"].get<double>() * 1e-6, e["relmse"].get<double>(),
-                e["relmse_trimmed"].get<double>(), e["ssim"].get<double>(),
-                has ? row["speedup_vs_pt"].get<double>() : 0.0);
-  }
+  print_summary(comparison_summary(result), config.runs);
   if (result.interrupted)
     std::fprintf(stderr, "compare: interrupted; the report holds the %zu integrators completed\n",
                  result.runs.size());
@@ -330,6 +347,12 @@ Runner add_compare_command(CLI::App& app) {
                  "Seconds for the reference render (default 4x --time; at most 30 days)");
   cmd->add_option("--out", o->out_dir,
                   "Output directory (default SCENE-compare), created if missing");
+  checks->integer("--runs", &o->runs, 1, kMaxCompareRuns,
+                  "Runs per integrator, with seeds --seed, --seed + 1, ... (default 1; at most " +
+                      std::to_string(kMaxCompareRuns) +
+                      "): the integrators take turns in each round, so that a drift of the "
+                      "machine's speed falls on all of them; the report shows each one's median "
+                      "run by relMSE and lists every run's errors (runs.csv)");
   return [o, checks](Ranks& ranks) { return run_compare(*o, *checks, ranks); };
 }
 

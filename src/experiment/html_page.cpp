@@ -39,6 +39,21 @@ std::string fmt_g(double v, const char* f = "%.4g") {
   return b;
 }
 
+// "seed: relMSE" of every run of a summary row, the shown (median) run in bold.
+std::string runs_cell(const nlohmann::json& row) {
+  if (!row.contains("relmse_runs")) return "-";
+  std::string cell;
+  const auto& seeds = row["seeds"];
+  const auto& rel = row["relmse_runs"];
+  for (size_t i = 0; i < rel.size(); ++i) {
+    const bool shown = seeds[i] == row["seed"];
+    cell += (i ? ", " : "") + std::string(shown ? "<b>" : "") +
+            std::to_string(seeds[i].get<uint64_t>()) + ": " + fmt_g(rel[i].get<double>()) +
+            (shown ? "</b>" : "");
+  }
+  return cell;
+}
+
 constexpr const char* kStyle = R"CSS(
 body { font-family: sans-serif; margin: 1.5em; color: #222; max-width: 1200px; }
 #buttons button { margin: 0 .3em .3em 0; padding: .3em .8em; border: 1px solid #888; background: #f4f4f4; cursor: pointer; }
@@ -149,17 +164,32 @@ std::string comparison_html(const ComparisonResult& result, const nlohmann::json
                    {"caption", result.reference_description}});
   for (const auto& r : result.runs) {
     const auto& e = r.snapshots.back().errors;
-    views.push_back({{"name", r.integrator},
-                     {"image", r.integrator + ".png"},
-                     {"error", r.integrator + "_error.png"},
-                     {"caption", std::to_string(r.iterations) + " iterations in " +
-                                     fmt_g(r.seconds, "%.1f") + " s, relMSE " + fmt_g(e.rel_mse)}});
+    views.push_back(
+        {{"name", r.integrator},
+         {"image", r.integrator + ".png"},
+         {"error", r.integrator + "_error.png"},
+         {"caption",
+          std::to_string(r.iterations) + " iterations in " + fmt_g(r.seconds, "%.1f") +
+              " s, relMSE " + fmt_g(e.rel_mse) +
+              (r.repeats.size() > 1 ? ", seed " + std::to_string(r.seed) + ": the median of " +
+                                          std::to_string(r.repeats.size()) + " runs"
+                                    : std::string())}});
   }
+  bool repeated = false;
+  for (const auto& r : result.runs) repeated = repeated || r.repeats.size() > 1;
   std::ostringstream o;
   o << "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>caustica: "
     << escape(result.scene) << "</title>\n<style>" << kStyle << "</style></head>\n<body>\n<h1>"
     << escape(result.scene) << ": " << fmt_g(result.config.seconds, "%g")
     << " s per integrator</h1>\n"
+    << (repeated
+            ? "<p>Each integrator ran " + std::to_string(result.config.runs) +
+                  " times, with seeds " + std::to_string(result.config.settings.seed) + " to " +
+                  std::to_string(result.config.settings.seed + result.config.runs - 1) +
+                  ", taking turns; the images, the curves and the summary's errors are "
+                  "each one's median run by relMSE, and the last column lists every "
+                  "run's.</p>\n"
+            : std::string())
     << "<p class=\"hint\">Keys: 0 reference, 1-9 integrators, arrows cycle, e error view, f fit. "
        "Wheel zooms, drag "
        "pans; the view stays put when switching.</p>\n"
@@ -171,7 +201,8 @@ std::string comparison_html(const ComparisonResult& result, const nlohmann::json
     << "<h2>Summary</h2>\n<table "
        "id=\"summary\"><thead><tr><th>integrator</th><th>iterations</th><th>Mrays/s</th>"
        "<th>RMSE</th><th>relMSE</th><th>relMSE (trimmed 0.1%)</th><th>SSIM</th><th>speed-up vs "
-       "pt</th></tr></thead><tbody>\n";
+       "pt</th>"
+    << (repeated ? "<th>relMSE of each run (seed: relMSE)</th>" : "") << "</tr></thead><tbody>\n";
   for (const auto& row : summary) {
     const auto& e = row["errors"];
     o << "<tr><td>" << escape(row["integrator"].get<std::string>()) << "</td><td>"
@@ -183,7 +214,9 @@ std::string comparison_html(const ComparisonResult& result, const nlohmann::json
       << (row.contains("speedup_vs_pt") && row["speedup_vs_pt"].is_number()
               ? fmt_g(row["speedup_vs_pt"].get<double>(), "%.2fx")
               : std::string("-"))
-      << "</td></tr>\n";
+      << "</td>";
+    if (repeated) o << "<td>" << runs_cell(row) << "</td>";
+    o << "</tr>\n";
   }
   o << "</tbody></table>\n<p class=\"hint\">Speed-up: the time pt needs to reach this integrator's "
        "final relMSE "

@@ -1,5 +1,7 @@
 #include "experiment/report.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -11,6 +13,34 @@
 
 namespace caustica {
 
+namespace {
+
+// With several runs per integrator: how many, their seeds and every run's relMSE (the row's
+// errors are the median run's).
+void add_repeats_summary(const IntegratorRun& r, nlohmann::json* row) {
+  const size_t n = std::max<size_t>(r.repeats.size(), 1);
+  (*row)["runs"] = n;
+  if (r.repeats.size() < 2) return;
+  nlohmann::json seeds = nlohmann::json::array(), rel = nlohmann::json::array(),
+                 trimmed = nlohmann::json::array();
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (const RepeatRun& x : r.repeats) {
+    seeds.push_back(x.seed);
+    rel.push_back(x.errors.rel_mse);
+    trimmed.push_back(x.errors.rel_mse_trimmed);
+    lo = std::min(lo, x.errors.rel_mse);
+    hi = std::max(hi, x.errors.rel_mse);
+  }
+  (*row)["seeds"] = seeds;
+  (*row)["relmse_runs"] = rel;
+  (*row)["relmse_trimmed_runs"] = trimmed;
+  (*row)["relmse_median"] = median_rel_mse(r);
+  (*row)["relmse_min"] = lo;
+  (*row)["relmse_max"] = hi;
+}
+
+}  // namespace
+
 nlohmann::json comparison_summary(const ComparisonResult& result) {
   const IntegratorRun* pt = nullptr;
   for (const auto& r : result.runs)
@@ -19,10 +49,12 @@ nlohmann::json comparison_summary(const ComparisonResult& result) {
   for (const auto& r : result.runs) {
     const ErrorMetrics& e = r.snapshots.back().errors;
     nlohmann::json row = {{"integrator", r.integrator},
+                          {"seed", r.seed},
                           {"seconds", r.seconds},
                           {"iterations", r.iterations},
                           {"rays_per_second", r.seconds > 0 ? double(r.rays) / r.seconds : 0.0},
                           {"errors", to_json(e)}};
+    add_repeats_summary(r, &row);
     if (pt == &r) {
       row["speedup_vs_pt"] = 1.0;  // by definition (its own curve is not monotonic)
     } else if (pt && r.seconds > 0) {
@@ -42,14 +74,21 @@ nlohmann::json comparison_json(const ComparisonResult& result) {
   j["scene"] = result.scene;
   j["seconds_per_integrator"] = result.config.seconds;
   j["threads"] = result.config.threads;
+  j["runs_per_integrator"] = result.config.runs;
   j["reference"] = result.reference_description;
   j["interrupted"] = result.interrupted;
   j["summary"] = comparison_summary(result);
   j["runs"] = nlohmann::json::array();
   for (const auto& r : result.runs) {
-    nlohmann::json run = {{"integrator", r.integrator}, {"seconds", r.seconds},
-                          {"iterations", r.iterations}, {"rays", r.rays},
-                          {"nonfinite", r.nonfinite},   {"stats", r.integrator_stats}};
+    nlohmann::json run = {
+        {"integrator", r.integrator}, {"seed", r.seed}, {"seconds", r.seconds},
+        {"iterations", r.iterations}, {"rays", r.rays}, {"nonfinite", r.nonfinite},
+        {"stats", r.integrator_stats}};
+    for (const RepeatRun& x : r.repeats)
+      run["repeats"].push_back({{"seed", x.seed},
+                                {"seconds", x.seconds},
+                                {"iterations", x.iterations},
+                                {"errors", to_json(x.errors)}});
     for (const auto& s : r.snapshots)
       run["snapshots"].push_back(
           {{"seconds", s.seconds}, {"iterations", s.iterations}, {"errors", to_json(s.errors)}});
@@ -149,6 +188,15 @@ void write_comparison_report(const ComparisonResult& result, const Image& refere
           << s.errors.rmse << ',' << s.errors.rel_mse << ',' << s.errors.rel_mse_trimmed << ','
           << s.errors.ssim << '\n';
   write_file_atomic((d / "results.csv").string(), csv.str());
+
+  std::ostringstream runs_csv;  // every run's final errors; `shown` marks the median run
+  runs_csv << "integrator,seed,seconds,iterations,relmse,relmse_trimmed,ssim,shown\n";
+  for (const auto& r : result.runs)
+    for (const RepeatRun& x : r.repeats)
+      runs_csv << r.integrator << ',' << x.seed << ',' << x.seconds << ',' << x.iterations << ','
+               << x.errors.rel_mse << ',' << x.errors.rel_mse_trimmed << ',' << x.errors.ssim << ','
+               << (x.seed == r.seed ? 1 : 0) << '\n';
+  write_file_atomic((d / "runs.csv").string(), runs_csv.str());
 
   const std::string svg = convergence_svg(result);
   write_file_atomic((d / "convergence.svg").string(), svg);

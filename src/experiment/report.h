@@ -1,6 +1,8 @@
 // Writes a comparison to a directory: per-integrator EXR and PNG, false-colour error images,
-// results.json, results.csv, convergence.svg and index.html — a page that opens from disk with
-// no network (all script and style inline; images are files beside it).
+// results.json, results.csv (every snapshot), runs.csv (every run's final errors: one per
+// integrator and seed), convergence.svg and index.html — a page that opens from disk with no
+// network (all script and style inline; images are files beside it). With several runs per
+// integrator the images, snapshots and curves are each integrator's median run.
 #pragma once
 
 #include <string>
@@ -20,7 +22,9 @@ void write_comparison_report(const ComparisonResult& result, const Image& refere
 std::string convergence_svg(const ComparisonResult& result, int width = 720, int height = 440);
 
 // Summary rows: final errors and speed-up relative to `pt` in time-to-equal-relMSE
-// (speedup = time pt needs to reach this integrator's final relMSE / this run's time).
+// (speedup = time pt needs to reach this integrator's final relMSE / this run's time), of each
+// integrator's median run; with several runs also their seeds, every run's relMSE, the median,
+// the least and the largest.
 nlohmann::json comparison_summary(const ComparisonResult& result);
 
 // What results.json holds: the scene, the settings, the summary rows and every run's snapshots.

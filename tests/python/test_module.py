@@ -213,7 +213,9 @@ class Compare(unittest.TestCase):
         results = caustica.compare(scene, ["pt", "vcm"], time=0.2, reference=reference,
                                    threads=1)
         self.assertEqual(set(results), {"scene", "seconds_per_integrator", "threads",
-                                        "reference", "interrupted", "summary", "runs"})
+                                        "runs_per_integrator", "reference", "interrupted",
+                                        "summary", "runs"})
+        self.assertEqual(results["runs_per_integrator"], 1)
         self.assertEqual(results["scene"], "cornell")
         self.assertEqual(results["threads"], 1)
         self.assertFalse(results["interrupted"])
@@ -222,6 +224,21 @@ class Compare(unittest.TestCase):
             self.assertGreater(run["iterations"], 0)
             self.assertEqual(row["errors"], run["snapshots"][-1]["errors"])
         self.assertEqual(results["summary"][0]["speedup_vs_pt"], 1.0)
+
+    def test_several_runs_keep_the_median_and_list_every_run(self):
+        scene = tiny()
+        reference = caustica.render(scene, "vcm", spp=16, seed=99)
+        results = caustica.compare(scene, "pt", time=0.1, reference=reference, threads=1,
+                                   seed=4, runs=3)
+        self.assertEqual(results["runs_per_integrator"], 3)
+        row, run = results["summary"][0], results["runs"][0]
+        self.assertEqual(row["seeds"], [4, 5, 6])
+        self.assertEqual([r["seed"] for r in run["repeats"]], [4, 5, 6])
+        self.assertEqual(sorted(row["relmse_runs"])[1], row["relmse_median"])
+        self.assertEqual(row["errors"]["relmse"], row["relmse_median"])
+        self.assertIn(run["seed"], [4, 5, 6])
+        with self.assertRaisesRegex(ValueError, "runs"):
+            caustica.compare(scene, "pt", time=0.1, reference=reference, runs=0)
 
     def test_without_a_reference_one_is_rendered_first(self):
         results = caustica.compare(tiny(), "pt", time=0.1, threads=1)

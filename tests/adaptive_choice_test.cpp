@@ -40,6 +40,7 @@ nlohmann::json synthetic_choice(int probes, uint32_t seed) {
     for (size_t p = 0; p < pixels; ++p) {
       AdaptivePlan::CandidateSums sums;  // r = s0 = s1 = 0: the moment is d
       for (float& d : sums.d) d = moment(rng);
+      sums.estimate = 1.f;  // the probe's own estimate: the mean (the square the moment loses)
       plan.pixel_end(p, sums);
     }
     ProbeWork w;

@@ -112,6 +112,8 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
   pt_missing_.assign(grid_pixels_, 0.f);
   probe_missing_.assign(grid_pixels_, 0.f);
   pooled_missing_squares_.assign(grid_pixels_, 0.0);
+  probe_estimate_.assign(grid_pixels_, 0.f);
+  mean_square_sums_.assign(grid_pixels_, 0.0);
   chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
   roulette_.fill(1.0);
 }
@@ -249,6 +251,8 @@ void AdaptivePlan::begin_probe(float radius) {
   std::fill(probe_missing_.begin(), probe_missing_.end(), 0.f);
   light_sums_.assign(grid_pixels_ * kLightSums * kCandidates, to_bfloat16(0.f));
   light_missing_pt_.assign(grid_pixels_, 0.f);
+  light_estimate_.assign(grid_pixels_, 0.f);
+  std::fill(probe_estimate_.begin(), probe_estimate_.end(), 0.f);
   const std::vector<Candidate>& list = candidates();
   for (size_t j = 0; j < kCandidates; ++j) {
     const MisCounts n = counts_of(list[j], pixels_, radius);
@@ -263,6 +267,7 @@ void AdaptivePlan::begin_probe(float radius) {
 void AdaptivePlan::add(CandidateSums& sums, float value, const TechniqueTerms* terms,
                        const MisCounts& counts, Share share) const {
   if (!(value != 0.f) || !std::isfinite(value)) return;
+  sums.estimate += value;
   if (!terms) {
     for (size_t j = 0; j < kCandidates; ++j) sums.r[j] += value;
     return;
@@ -324,6 +329,7 @@ void AdaptivePlan::add_light_trace(size_t pixel, float value, const TechniqueTer
   CandidateSums sums = pixel_start(pixel);
   add(sums, value, terms, counts);
   light_missing_pt_[grid_index(pixel)] = sums.missing_pt;
+  light_estimate_[grid_index(pixel)] = sums.estimate;
   uint16_t* stored = &light_sums_[grid_index(pixel) * kLightSums * kCandidates];
   for (size_t j = 0; j < kCandidates; ++j) {
     stored[j] = to_bfloat16(sums.r[j]);
@@ -341,6 +347,7 @@ AdaptivePlan::CandidateSums AdaptivePlan::pixel_start(size_t pixel) const {
     sums.u[j] = from_bfloat16(stored[2 * kCandidates + j]);
   }
   sums.missing_pt = light_missing_pt_.empty() ? 0.f : light_missing_pt_[grid_index(pixel)];
+  sums.estimate = light_estimate_.empty() ? 0.f : light_estimate_[grid_index(pixel)];
   return sums;
 }
 
@@ -349,6 +356,7 @@ void AdaptivePlan::pixel_end(size_t pixel, const CandidateSums& sums, double cam
   pixel_vertices_[g] += float(camera_vertices);  // integers: exact far beyond any probe count
   pt_missing_[g] += sums.missing_pt;
   probe_missing_[g] += sums.missing_pt;
+  probe_estimate_[g] += sums.estimate;
   uint8_t* m = &moments_[g * kCandidates * 3];
   uint8_t* odd = probes_ % 2 == 1 ? &moments_odd_[g * kCandidates * 3] : nullptr;
   for (size_t j = 0; j < kCandidates; ++j) {
@@ -388,6 +396,7 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   // renders; released before the choice, so that its buffers do not add to them.
   std::vector<uint16_t>().swap(light_sums_);
   std::vector<float>().swap(light_missing_pt_);
+  std::vector<float>().swap(light_estimate_);
   // The cost model's photons are those of one light path per pixel (merge_cost scales them
   // with a candidate's factor); a sparse probe traces the chosen light paths.
   ProbeWork normalized = w;
@@ -405,6 +414,9 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
     return;
   }
   const std::vector<float> grid_means = on_grid(means);
+  for (size_t p = 0; p < grid_pixels_; ++p)
+    mean_square_sums_[p] += double(grid_means[p]) * double(probe_estimate_[p]);
+  ++mean_square_probes_;
   if (measured.size() == pixels_ && chosen_j_ < kCandidates)
     check_last_choice(on_grid(measured), iterations, thread_seconds, grid_means);
   // A choice needs the film's means (from the iterations before the probe) and two probes.

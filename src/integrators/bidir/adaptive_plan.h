@@ -224,6 +224,7 @@ class AdaptivePlan {
   struct CandidateSums {
     std::array<float, kCandidates> r{}, s0{}, s1{}, d{}, u{};
     float missing_pt = 0;
+    float estimate = 0;  // the probe's own estimate of the pixel: the sum of its contributions
   };
   // radius: the probe's merge radius (the candidates' merge counts N' pi r^2).
   void begin_probe(float radius);
@@ -373,6 +374,19 @@ class AdaptivePlan {
   // bias^2 (path_tracing_bias).
   std::vector<float> probe_missing_;
   std::vector<double> pooled_missing_squares_;
+  // The square of a pixel's mean that its variance subtracts from the candidates' second
+  // moments, unbiased: per grid pixel the sum over probes of the film's mean before the probe
+  // times the probe's own estimate (independent: different iterations), and how many probes
+  // added to it. The square of the film's mean itself exceeds mu^2 by that mean's variance,
+  // which at the first choice (a film of one iteration, the first probe) is a whole iteration's:
+  // every candidate's variance came out too low by it (docs/adaptive-vcm.md, "The first
+  // choice's bias"). Without a film before any probe yet, the film's mean squared stands.
+  std::vector<float> probe_estimate_;  // this probe's (pixel_end), per grid pixel
+  std::vector<float> light_estimate_;  // this probe's light-tracing splats (add_light_trace)
+  std::vector<double> mean_square_sums_;
+  int mean_square_probes_ = 0;
+  // mean^2 for pixel p whose film mean is m: mean_square_sums_ / mean_square_probes_, or m^2.
+  double mean_square(size_t p, double m) const;
   // Per grid pixel, pooled as the variances are: what path tracing's bias adds to its variance
   // per iteration, the relative bias^2 times the weight that turns it into a per-iteration
   // variance, the iterations path tracing would render in the budget

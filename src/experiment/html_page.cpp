@@ -182,14 +182,14 @@ std::string comparison_html(const ComparisonResult& result, const nlohmann::json
     << escape(result.scene) << "</title>\n<style>" << kStyle << "</style></head>\n<body>\n<h1>"
     << escape(result.scene) << ": " << fmt_g(result.config.seconds, "%g")
     << " s per integrator</h1>\n"
-    << (repeated
-            ? "<p>Each integrator ran " + std::to_string(result.config.runs) +
-                  " times, with seeds " + std::to_string(result.config.settings.seed) + " to " +
-                  std::to_string(result.config.settings.seed + result.config.runs - 1) +
-                  ", taking turns; the images, the curves and the summary's errors are "
-                  "each one's median run by relMSE, and the last column lists every "
-                  "run's.</p>\n"
-            : std::string())
+    << (repeated ? "<p>Each integrator ran " + std::string(result.interrupted ? "up to " : "") +
+                       std::to_string(result.config.runs) + " times, with seeds " +
+                       std::to_string(result.config.settings.seed) + " to " +
+                       std::to_string(result.config.settings.seed + result.config.runs - 1) +
+                       ", taking turns; the images, the curves and the summary's errors are "
+                       "each one's median run by relMSE, and the last column lists every "
+                       "run's.</p>\n"
+                 : std::string())
     << "<p class=\"hint\">Keys: 0 reference, 1-9 integrators, arrows cycle, e error view, f fit. "
        "Wheel zooms, drag "
        "pans; the view stays put when switching.</p>\n"

@@ -88,3 +88,64 @@ TEST(AdaptiveChoice, TheMixIsPricedOnProbesThatDidNotChooseIt) {
     EXPECT_EQ(rows, int(AdaptivePlan::kCoreCandidates - 1) / 2) << probes;
   }
 }
+
+namespace {
+
+// The candidates' predicted relative variance (every candidate's: the probes' samples are made by
+// one technique) after `probes` synthetic probes of a w x h image whose every pixel has one
+// sample per probe, exponential with mean 1 (variance 1, heavy-tailed as a light transport
+// estimate): the variance it predicts per iteration divided by (mean^2 + 0.01). The film's mean
+// before each probe is that of the probes before it, as when the integrator probes every
+// iteration before its first choice.
+double predicted_from_exponential_samples(int probes, uint32_t seed) {
+  const int w = 64, h = 64;
+  AdaptivePlan plan(w, h, /*measured_costs=*/false, /*probe_every_iteration=*/true,
+                    /*probe_stride=*/1);
+  const size_t pixels = size_t(w) * h;
+  MisCounts counts;
+  counts.light_trace = float(pixels);
+  counts.connect = 2;
+  counts.merge = 1;
+  std::mt19937 rng(seed);
+  std::exponential_distribution<float> sample(1.f);
+  std::vector<double> sums(pixels, 0.0);
+  for (int probe = 0; probe < probes; ++probe) {
+    std::vector<float> means;
+    if (probe > 0)
+      for (double s : sums) means.push_back(float(s / probe));
+    plan.begin_probe(0.1f);
+    for (size_t p = 0; p < pixels; ++p) {
+      AdaptivePlan::CandidateSums c = plan.pixel_start(p);
+      const float v = sample(rng);
+      plan.add(c, v, nullptr, counts);
+      plan.pixel_end(p, c);
+      sums[p] += v;
+    }
+    ProbeWork work;
+    work.light_paths = double(pixels);
+    work.light_vertices = work.camera_vertices = work.nondelta_camera_vertices = 2.0 * pixels;
+    plan.finish_probe(work, means);
+  }
+  nlohmann::json stats;
+  plan.report(stats);
+  return stats["adaptive"]["history"].back()["candidates"][1]["relative_variance_no_merge"];
+}
+
+}  // namespace
+
+// At the first choice the film holds one iteration, and its per-pixel mean is as noisy as one
+// sample. Its square taken for mu^2 made every variance too low by a whole sample's variance
+// (the numerator, commit 9a49891: here about 0), and 1 / (m^2 + 0.01) of that one sample is far
+// above 1 / (mu^2 + 0.01) on average (the denominator: here several times the truth). The plan
+// subtracts the product of independent estimates and divides by the film's mean shrunk toward
+// its 7 x 7 pooled value where they differ by less than the mean's noise
+// (AdaptivePlan::denominators), so two probes price the variance close to the truth, and more
+// probes do no worse.
+TEST(AdaptiveChoice, TheFirstChoiceIsPricedWithoutTheNoiseOfTheFilmsMean) {
+  const double truth = 1.0 / (1.0 + 0.01);
+  for (int probes : {2, 3, 8}) {
+    const double predicted = predicted_from_exponential_samples(probes, 7 + uint32_t(probes));
+    std::printf("[ adaptive ] %d probes: predicted %.4f, truth %.4f\n", probes, predicted, truth);
+    EXPECT_NEAR(predicted / truth, 1.0, 0.1) << probes;
+  }
+}

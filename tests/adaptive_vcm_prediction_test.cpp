@@ -377,7 +377,11 @@ TEST(AdaptiveVcm, PathTracingsBiasIsWeighedAgainstTheBudget) {
     plan.report(stats);
     const auto& last = stats["adaptive"]["history"].back();
     EXPECT_EQ(last["path_tracing_bias_iterations"].get<double>(), budget);
-    EXPECT_NEAR(last["path_tracing_relative_bias"].get<double>(), kPooledBlockBias, 1e-9);
+    // The denominators shrink the film's means toward their pooled value where the two differ by
+    // less than two standard errors (AdaptivePlan::denominators): the probes' noise says the
+    // block's edge does, though the means given here are exact (1.8% at a million iterations).
+    EXPECT_NEAR(last["path_tracing_relative_bias"].get<double>(), kPooledBlockBias,
+                0.03 * kPooledBlockBias);
     const bidir::IterationPlan chosen = plan.plan(3);
     if (budget < 100) {
       EXPECT_EQ(chosen.light_paths, 0u);

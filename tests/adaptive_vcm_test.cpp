@@ -122,14 +122,20 @@ TEST(AdaptiveVcm, KeepsMergingForCausticsAndReportsWhy) {
   ASSERT_FALSE(a["history"].empty());
   EXPECT_EQ(a["probes"].get<size_t>(), 1 + a["probe_iterations"].size());  // 0, and those
   EXPECT_GT(a["light_paths_per_iteration"].get<uint64_t>(), 0u);
-  // 2.4% of the pixels with one light path per pixel; 1.2% (a block on the glass sphere's lower
-  // half, which shows the floor and its caustic through the glass) with the two light paths
-  // chosen since the roulette factor is a mean over pixels.
+  // It merges at least where the caustic is (a block on the glass sphere's lower half, which
+  // shows the floor and its caustic through the glass: 1.2-2.4% of the pixels while the
+  // relative variance divided by the film's one-iteration mean^2). Since the denominators shrink
+  // that mean toward its neighbours' (AdaptivePlan::denominators) it merges everywhere: merging
+  // is priced 4x better than not on average (0.157 against 0.688), and the per-pixel mix,
+  // cross-fitted on one probe per half, no better than that. At equal time (1 s, 8 seeds each,
+  // 48 x 48) `vcm` rendered 0.84x the median relMSE of the mixed choices before.
   EXPECT_GT(a["merge_fraction"].get<double>(), 0.005);
-  EXPECT_LT(a["merge_fraction"].get<double>(), 1.0);
   const auto& mask = a["merge_mask"];
   EXPECT_EQ(mask["width"].get<int>() * mask["block"].get<int>(), 48);
   EXPECT_EQ(mask["fraction"].size(), size_t(mask["width"].get<int>() * mask["height"].get<int>()));
+  double masked = 0;  // the mask's blocks are whole here (48 = width x block): their mean
+  for (const auto& f : mask["fraction"]) masked += f.get<double>();
+  EXPECT_NEAR(masked / double(mask["fraction"].size()), a["merge_fraction"].get<double>(), 1e-9);
   // The candidate table prices path tracing far worse than what was chosen: it misses the
   // energy of paths it cannot make in more pixels, or scores at least twice as high.
   const auto& table = a["history"].back()["candidates"];

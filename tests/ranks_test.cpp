@@ -309,19 +309,19 @@ nlohmann::json adaptive_report(const Scene& scene, const IntegratorSettings& set
   return stats["adaptive"];
 }
 
-// adaptive-vcm learns from its probes (iterations 0, 1, then as their predicted cost allows:
-// here 5 and 15): every rank renders each of them, and the means that normalise their
-// variances come from the film summed over the ranks, so the choices, the schedule of the
+// adaptive-vcm learns from its probes (iterations 0, 1, then as their predicted cost allows; at
+// least four in 128 iterations here): every rank renders each of them, and the means that normalise
+// their variances come from the film summed over the ranks, so the choices, the schedule of the
 // probes and the image are those of one process.
 TEST(RanksRender, AdaptiveVcmOnTwoRanksGivesTheOneProcessImageBitForBit) {
   auto scene = make_builtin_scene("cornell-glass", 24, 20);
   IntegratorSettings settings;
   settings.seed = 7;
-  const int spp = 64;
+  const int spp = 128;
   const RenderResult single = test::render_with(*scene, "adaptive-vcm", spp, settings);
   const PairResult pair = render_on_thread_pair(*scene, "adaptive-vcm", settings, spp);
-  EXPECT_EQ(pair.iterations[0], 32u);  // its own: 0, 2, ..., 62
-  EXPECT_EQ(pair.iterations[1], 32u);
+  EXPECT_EQ(pair.iterations[0], 64u);  // its own: 0, 2, ..., 126
+  EXPECT_EQ(pair.iterations[1], 64u);
   const int probes = adaptive_report(*scene, settings, spp)["probes"].get<int>();
   EXPECT_GE(probes, 4);
   EXPECT_EQ(pair.sums, probes) << "one sum of the films before each probe";

@@ -21,6 +21,9 @@ namespace caustica::bidir {
 namespace {
 constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
 constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
+// A pixel's film mean is kept where it differs from its pooled mean by more than this many of
+// its standard errors (AdaptivePlan::denominators, the positive-part James-Stein factor).
+constexpr double kShrinkSigmas = 2.0;
 // Path tracing is kept unless another configuration's predicted relVar x time is lower by more
 // than this factor. The cost model has no term for the per-iteration costs of light paths (their
 // pipeline, the splats), and the predicted variances carry a few percent of noise: on mis-plates
@@ -267,15 +270,41 @@ double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<flo
                             ? get_float24(&moments_odd_[i]) / double(odd_probes)
                             : (all - get_float24(&moments_odd_[i])) / double(probes_ - odd_probes);
   // Signed: clamped only after pooling (relative_variances).
-  return (moment - square) / (m * m + kRelEps) * roulette_[j];
+  return (moment - square) / denominator_[p] * roulette_[j];
+}
+
+std::vector<double> AdaptivePlan::denominators(const std::vector<float>& means) const {
+  std::vector<double> d(grid_pixels_);
+  const double k = double(estimate_probes_), n = film_iterations_;
+  if (k < 2 || !(n > 0)) {
+    for (size_t p = 0; p < grid_pixels_; ++p) d[p] = double(means[p]) * means[p] + kRelEps;
+    return d;
+  }
+  const std::vector<double> m(means.begin(), means.end());
+  const std::vector<double> pooled = box_blur(m, grid_w_, grid_h_, kPoolRadius);
+  std::vector<double> own(grid_pixels_);
+  for (size_t p = 0; p < grid_pixels_; ++p)
+    own[p] = (estimate_square_sums_[p] - estimate_sums_[p] * estimate_sums_[p] / k) / (k - 1);
+  const std::vector<double> pooled_variance = box_blur(own, grid_w_, grid_h_, kPoolRadius);
+  for (size_t p = 0; p < grid_pixels_; ++p) {
+    // The film mean's variance (a few kShrinkSigmas of its standard error, squared), from the
+    // larger of the pixel's own and its pooled variance of one probe's estimate: an outlier
+    // raises its own, and a pixel whose few probes happened to agree keeps its neighbours'.
+    const double noise =
+        kShrinkSigmas * kShrinkSigmas * std::max({own[p], pooled_variance[p], 0.0}) / n;
+    const double diff = m[p] - pooled[p];
+    const double keep = diff * diff > noise ? 1.0 - noise / (diff * diff) : 0.0;
+    const double shrunk = pooled[p] + keep * diff;
+    d[p] = shrunk * shrunk + kRelEps;
+  }
+  return d;
 }
 
 double AdaptivePlan::mean_square(size_t p, double m) const {
   return mean_square_probes_ > 0 ? mean_square_sums_[p] / double(mean_square_probes_) : m * m;
 }
 
-std::vector<double> AdaptivePlan::path_tracing_bias(const std::vector<float>& means, double weight,
-                                                    double* relative_sum) const {
+std::vector<double> AdaptivePlan::path_tracing_bias(double weight, double* relative_sum) const {
   // The square of the missed energy's mean, pooled over 7 x 7 as the variances are. The square
   // of a mean over K probes overestimates the square of the bias by the mean's variance; the
   // mean over pairs of different probes of M_k M_l (M_k: probe k's missed energy pooled over the
@@ -290,8 +319,7 @@ std::vector<double> AdaptivePlan::path_tracing_bias(const std::vector<float>& me
   const double k = double(probes_);
   std::vector<double> sum(pt_missing_.begin(), pt_missing_.end());
   sum = box_blur(sum, grid_w_, grid_h_, kPoolRadius);  // sum over probes of M_k
-  std::vector<double> norm(grid_pixels_);
-  for (size_t p = 0; p < grid_pixels_; ++p) norm[p] = double(means[p]) * means[p] + kRelEps;
+  std::vector<double> norm = denominator_;
   norm = box_blur(norm, grid_w_, grid_h_, kPoolRadius);
   std::vector<double> bias(grid_pixels_);
   for (size_t p = 0; p < grid_pixels_; ++p) {
@@ -357,7 +385,7 @@ void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
                                                   : relative_variance(p, j, means);
       diff[p] = std::isfinite(variance[p])
                     ? get_float24(&roulette_diff_[(p * kCandidates + j) * 3]) /
-                          (double(probes_) * (double(means[p]) * means[p] + kRelEps))
+                          (double(probes_) * denominator_[p])
                     : 0.0;
     }
     variance = box_blur(variance, grid_w_, grid_h_, kPoolRadius);
@@ -431,6 +459,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   const double pixels = double(grid_pixels_);
   const PixelWork pw = pixel_work_of(work_, double(probes_), pixels, kProbeConnections);
   const CostModel t = costs_of(work_, measured_);
+  denominator_ = denominators(means);
   update_roulette_factors(means);
   const std::vector<double> weights = pixel_cost_weights();
   // Every probe, then the even and the odd ones alone (cross-fitting needs one in each).
@@ -442,8 +471,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   std::array<std::array<std::vector<double>, kStopCandidates>, 3> stop;
   // Path tracing's bias where it misses energy, weighted by the iterations it would render.
   bias_iterations_ = path_tracing_bias_weight(pw, t);
-  const std::vector<double> pt_bias =
-      path_tracing_bias(means, bias_iterations_, &relative_bias_sum_);
+  const std::vector<double> pt_bias = path_tracing_bias(bias_iterations_, &relative_bias_sum_);
   for (size_t h = 0; h < sets; ++h) {
     correction[h] = shared_firefly_correction(means, halves[h]);
     pt[h] = relative_variances(0, means, correction[h], halves[h], &pt_bias);

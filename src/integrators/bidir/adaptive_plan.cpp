@@ -114,6 +114,8 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
   pooled_missing_squares_.assign(grid_pixels_, 0.0);
   probe_estimate_.assign(grid_pixels_, 0.f);
   mean_square_sums_.assign(grid_pixels_, 0.0);
+  estimate_sums_.assign(grid_pixels_, 0.0);
+  estimate_square_sums_.assign(grid_pixels_, 0.0);
   chosen_.light_paths = pixels_;  // full VCM until the first probe is priced
   roulette_.fill(1.0);
 }
@@ -386,7 +388,13 @@ void add_counts(ProbeWork& total, const ProbeWork& w) {
 void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means,
                                 const std::vector<double>& measured, double iterations,
                                 double thread_seconds) {
+  film_iterations_ = double(probe_all_ || probes_ < kFirstProbes ? uint64_t(probes_) : next_probe_);
   ++probes_;
+  for (size_t p = 0; p < grid_pixels_; ++p) {
+    estimate_sums_[p] += probe_estimate_[p];
+    estimate_square_sums_[p] += double(probe_estimate_[p]) * probe_estimate_[p];
+  }
+  ++estimate_probes_;
   {
     std::vector<double> pooled(probe_missing_.begin(), probe_missing_.end());
     pooled = box_blur(pooled, grid_w_, grid_h_, kPoolRadius);

@@ -385,6 +385,24 @@ class AdaptivePlan {
   std::vector<float> light_estimate_;  // this probe's light-tracing splats (add_light_trace)
   std::vector<double> mean_square_sums_;
   int mean_square_probes_ = 0;
+  // Per grid pixel, over every probe: the sum of the probe's own estimates and of their squares
+  // (the variance of one probe's estimate, for denominators()), and how many probes added.
+  std::vector<double> estimate_sums_, estimate_square_sums_;
+  int estimate_probes_ = 0;
+  // The film's iterations before the probe being finished: its means' sample count.
+  double film_iterations_ = 0;
+  // Per grid pixel: the relative variance's denominator mu^2 + 0.01, set by choose() and read
+  // while it chooses (denominator_). The film's mean m holds a few iterations at the first
+  // choices (one at the first), and 1 / (m^2 + 0.01) of so noisy a mean is far above
+  // 1 / (mu^2 + 0.01) on average (most in the noisiest pixels, where m mostly falls below mu):
+  // after 2 probes on point-room every prediction was 1.47-1.69x what rendering showed (docs/
+  // adaptive-vcm.md, "The first choice's bias"). So m is shrunk toward its 7 x 7 pooled mean M:
+  // m' = M + max(0, 1 - c^2 s^2 / (n (m - M)^2)) (m - M), the positive-part James-Stein factor
+  // with c = kShrinkSigmas standard errors, s^2 the variance of one probe's estimate there and n
+  // the film's iterations. A pixel that stands out from its neighbours by more than that (an
+  // emitter's edge) keeps its own mean, and as n grows every pixel does.
+  std::vector<double> denominators(const std::vector<float>& means) const;
+  std::vector<double> denominator_;
   // mean^2 for pixel p whose film mean is m: mean_square_sums_ / mean_square_probes_, or m^2.
   double mean_square(size_t p, double m) const;
   // Per grid pixel, pooled as the variances are: what path tracing's bias adds to its variance
@@ -393,8 +411,7 @@ class AdaptivePlan {
   // (path_tracing_bias_weight). Without a budget (an infinite weight) any missed energy rules
   // it out, as every candidate that misses energy is.
   // relative_sum: the relative bias^2 summed over the pixels (unweighted, for the report).
-  std::vector<double> path_tracing_bias(const std::vector<float>& means, double weight,
-                                        double* relative_sum) const;
+  std::vector<double> path_tracing_bias(double weight, double* relative_sum) const;
   double path_tracing_bias_weight(const PixelWork& pw, const CostModel& t) const;
   double bias_iterations_ = 0;    // the last choice's weight, for the report
   double relative_bias_sum_ = 0;  // and path tracing's relative bias^2 summed over pixels

@@ -287,9 +287,10 @@ std::vector<double> AdaptivePlan::denominators(const std::vector<float>& means) 
     own[p] = (estimate_square_sums_[p] - estimate_sums_[p] * estimate_sums_[p] / k) / (k - 1);
   const std::vector<double> pooled_variance = box_blur(own, grid_w_, grid_h_, kPoolRadius);
   for (size_t p = 0; p < grid_pixels_; ++p) {
-    // The film mean's variance (a few kShrinkSigmas of its standard error, squared), from the
-    // larger of the pixel's own and its pooled variance of one probe's estimate: an outlier
-    // raises its own, and a pixel whose few probes happened to agree keeps its neighbours'.
+    // kShrinkSigmas^2 times the film mean's variance, from the larger of the pixel's own and
+    // its pooled variance of one probe's estimate: an outlier raises its own, and a pixel whose
+    // few probes happened to agree takes its neighbours'. (The film's iterations after the
+    // first choice render the choice, not the probe: the probe's variance stands in.)
     const double noise =
         kShrinkSigmas * kShrinkSigmas * std::max({own[p], pooled_variance[p], 0.0}) / n;
     const double diff = m[p] - pooled[p];

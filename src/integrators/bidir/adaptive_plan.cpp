@@ -388,6 +388,8 @@ void add_counts(ProbeWork& total, const ProbeWork& w) {
 void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means,
                                 const std::vector<double>& measured, double iterations,
                                 double thread_seconds) {
+  // This probe's iteration index, the count of the film's iterations before it (the first
+  // probes come at 0 and 1, then at next_probe_; probe_all_: every iteration).
   film_iterations_ = double(probe_all_ || probes_ < kFirstProbes ? uint64_t(probes_) : next_probe_);
   ++probes_;
   for (size_t p = 0; p < grid_pixels_; ++p) {

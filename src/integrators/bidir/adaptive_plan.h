@@ -398,8 +398,9 @@ class AdaptivePlan {
   // after 2 probes on point-room every prediction was 1.47-1.69x what rendering showed (docs/
   // adaptive-vcm.md, "The first choice's bias"). So m is shrunk toward its 7 x 7 pooled mean M:
   // m' = M + max(0, 1 - c^2 s^2 / (n (m - M)^2)) (m - M), the positive-part James-Stein factor
-  // with c = kShrinkSigmas standard errors, s^2 the variance of one probe's estimate there and n
-  // the film's iterations. A pixel that stands out from its neighbours by more than that (an
+  // with c = kShrinkSigmas standard errors, s^2 the variance of one probe's estimate there (the
+  // larger of the pixel's own over the probes and its 7 x 7 pooled value) and n the film's
+  // iterations. A pixel that stands out from its neighbours by more than that (an
   // emitter's edge) keeps its own mean, and as n grows every pixel does.
   std::vector<double> denominators(const std::vector<float>& means) const;
   std::vector<double> denominator_;

@@ -275,7 +275,7 @@ double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<flo
 
 std::vector<double> AdaptivePlan::denominators(const std::vector<float>& means) const {
   std::vector<double> d(grid_pixels_);
-  const double k = double(estimate_probes_), n = film_iterations_;
+  const double k = double(probes_), n = double(probe_iteration());
   if (k < 2 || !(n > 0)) {
     for (size_t p = 0; p < grid_pixels_; ++p) d[p] = double(means[p]) * means[p] + kRelEps;
     return d;
@@ -348,8 +348,7 @@ double AdaptivePlan::path_tracing_bias_weight(const PixelWork& pw, const CostMod
   // the pace the model's costs have run so far (its predicted microseconds per pixel of every
   // iteration, accounted as schedule_next_probe does; before the first choice every iteration
   // was a full probe).
-  const uint64_t probe =
-      probe_all_ || probes_ <= kFirstProbes ? uint64_t(probes_ - 1) : next_probe_;
+  const uint64_t probe = probe_iteration();
   double spent = 0;
   if (probe_iterations_.empty()) {
     const Candidate probe_config{1.f, kProbeConnections, true};

@@ -388,15 +388,11 @@ void add_counts(ProbeWork& total, const ProbeWork& w) {
 void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& means,
                                 const std::vector<double>& measured, double iterations,
                                 double thread_seconds) {
-  // This probe's iteration index, the count of the film's iterations before it (the first
-  // probes come at 0 and 1, then at next_probe_; probe_all_: every iteration).
-  film_iterations_ = double(probe_all_ || probes_ < kFirstProbes ? uint64_t(probes_) : next_probe_);
   ++probes_;
   for (size_t p = 0; p < grid_pixels_; ++p) {
     estimate_sums_[p] += probe_estimate_[p];
     estimate_square_sums_[p] += double(probe_estimate_[p]) * probe_estimate_[p];
   }
-  ++estimate_probes_;
   {
     std::vector<double> pooled(probe_missing_.begin(), probe_missing_.end());
     pooled = box_blur(pooled, grid_w_, grid_h_, kPoolRadius);

@@ -386,11 +386,14 @@ class AdaptivePlan {
   std::vector<double> mean_square_sums_;
   int mean_square_probes_ = 0;
   // Per grid pixel, over every probe: the sum of the probe's own estimates and of their squares
-  // (the variance of one probe's estimate, for denominators()), and how many probes added.
+  // (the variance of one probe's estimate, for denominators()).
   std::vector<double> estimate_sums_, estimate_square_sums_;
-  int estimate_probes_ = 0;
-  // The film's iterations before the probe being finished: its means' sample count.
-  double film_iterations_ = 0;
+  // The iteration of the probe just finished (finish_probe, before schedule_next_probe): the
+  // first probes come at 0 and 1, then at next_probe_ (probe_all_: every iteration). It is also
+  // the count of the film's iterations before that probe, its means' sample count.
+  uint64_t probe_iteration() const {
+    return probe_all_ || probes_ <= kFirstProbes ? uint64_t(probes_ - 1) : next_probe_;
+  }
   // Per grid pixel: the relative variance's denominator mu^2 + 0.01, set by choose() and read
   // while it chooses (denominator_). The film's mean m holds a few iterations at the first
   // choices (one at the first), and 1 / (m^2 + 0.01) of so noisy a mean is far above

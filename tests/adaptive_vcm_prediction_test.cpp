@@ -207,8 +207,8 @@ TEST(AdaptiveVcm, RussianRouletteIsPricedIntoCandidatesWithoutConnections) {
 TEST(AdaptiveVcm, WhatAChoiceShowsMatchesWhatWasPredictedForIt) {
   // cornell: path tracing is chosen (pt's estimator, whose power heuristic the prediction
   // under the balance heuristic slightly over-prices), so cheap beside a probe that the
-  // probes come far apart (iterations 11, 39, 102, 236); cornell-glass: light paths and merging
-  // (probes at 5, 14, 34, 64, 124).
+  // probes come far apart, the more so as the choice repeats (iterations 11, 64, 325);
+  // cornell-glass: light paths and merging (probes at 6, 27, 71).
   for (const auto& [name, spp] : {std::pair{"cornell", 512}, std::pair{"cornell-glass", 128}}) {
     auto scene = make_builtin_scene(name, 32, 32);
     IntegratorSettings s;
@@ -217,7 +217,7 @@ TEST(AdaptiveVcm, WhatAChoiceShowsMatchesWhatWasPredictedForIt) {
     const nlohmann::json stats = adaptive_stats(*scene, s, spp);
     const auto& checks = stats["adaptive"]["checks"];
     const auto& probes = stats["adaptive"]["probe_iterations"];  // from the second probe on
-    ASSERT_GE(checks.size(), 4u) << name;
+    ASSERT_GE(checks.size(), 3u) << name;
     // One check before each probe after the first choice, of the iterations since the last.
     ASSERT_EQ(checks.size() + 1, probes.size()) << name;
     for (size_t i = 0; i < checks.size(); ++i)

@@ -564,26 +564,34 @@ void AdaptivePlan::record_choice(const char* variant, const CostModel& t, nlohma
                       {"merge_fraction", fraction_of(modes_, PixelMode::Merge)},
                       {"path_trace_fraction", fraction_of(modes_, PixelMode::PathTrace)},
                       {"stop_fraction", fraction_of(modes_, PixelMode::Stop)},
+                      {"settled_choices", settled_choices_},
                       {"costs_us", to_json(t)},
                       {"candidates", std::move(table)}});
 }
 
 void AdaptivePlan::take_choice(size_t j, const std::vector<PixelMode>& grid_modes) {
   const Candidate& c = candidates()[j];
+  // Each image pixel takes the mode of its block's probed pixel (the last row and column of
+  // grid pixels also cover what is left of the image beyond them).
+  size_t changed = 0;
+  for (int y = 0; y < height_; ++y) {
+    const size_t gy = std::min(size_t(y) / stride_, size_t(grid_h_ - 1));
+    for (int x = 0; x < width_; ++x) {
+      const size_t gx = std::min(size_t(x) / stride_, size_t(grid_w_ - 1));
+      PixelMode& mode = modes_[size_t(y) * width_ + x];
+      changed += mode != grid_modes[gy * grid_w_ + gx];
+      mode = grid_modes[gy * grid_w_ + gx];
+    }
+  }
+  // A choice that repeats the last one (the same candidate, at most kSettledChange of the
+  // pixels in another mode) lets the next probe wait longer (schedule_next_probe).
+  const bool repeats = chosen_j_ == j && double(changed) <= kSettledChange * double(pixels_);
+  settled_choices_ = repeats ? settled_choices_ + 1 : 0;
   chosen_j_ = j;
   chosen_ = {};
   chosen_.light_paths = uint64_t(std::llround(double(c.light_path_factor) * double(pixels_)));
   chosen_.connections = c.connections;
   chosen_.merge_everywhere = false;
-  // Each image pixel takes the mode of its block's probed pixel (the last row and column of
-  // grid pixels also cover what is left of the image beyond them).
-  for (int y = 0; y < height_; ++y) {
-    const size_t gy = std::min(size_t(y) / stride_, size_t(grid_h_ - 1));
-    for (int x = 0; x < width_; ++x) {
-      const size_t gx = std::min(size_t(x) / stride_, size_t(grid_w_ - 1));
-      modes_[size_t(y) * width_ + x] = grid_modes[gy * grid_w_ + gx];
-    }
-  }
   chosen_.splats_nowhere = std::none_of(modes_.begin(), modes_.end(), [](PixelMode m) {
     return m == PixelMode::Bidirectional || m == PixelMode::Merge;
   });

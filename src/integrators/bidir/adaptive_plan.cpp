@@ -162,7 +162,12 @@ void AdaptivePlan::schedule_next_probe() {
     // after a probe at i (3, 7, 15, ...), and where the choice is much cheaper than a probe
     // (path tracing beside a probe's full VCM with two connections: 5x its cost on coffee) as
     // much later.
-    gap = uint64_t(std::ceil(std::max(1.0, (spent_cost_ - probe_cost) / choice)));
+    // A choice that repeated the last one k times in a row (settled_choices_) waits k + 1 times
+    // as long: a probe is worth its cost while the choice may still change, and the probes of a
+    // scene that path traces every pixel (full VCM beside path tracing) took 14% of 20 s on
+    // material-testball, which lost 1.12x to pt for it (docs/adaptive-vcm.md).
+    gap = uint64_t(std::ceil(
+        std::max(1.0, double(1 + settled_choices_) * (spent_cost_ - probe_cost) / choice)));
     // No probe whose excess would take the probes beyond kMaxProbeShare of the render's
     // predicted cost (the rest of the budget at this choice): at 3, 7, 15, ... they took 22-35%
     // of 20 s at the scenes' own resolutions where the choice was cheap.

@@ -34,7 +34,8 @@
 //
 // Probes are iterations 0 and 1, then each once the iterations since the last one have cost
 // (predicted by the fixed model) what everything before it did, so their cost fades as the
-// render grows (with one cost per iteration: 3, 7, 15, 31, ...), and none that would take the
+// render grows (with one cost per iteration: 3, 7, 15, 31, ...; k + 1 times as long after a
+// choice that repeated the one before k times in a row), and none that would take the
 // probes beyond kMaxProbeShare of the budget's predicted time in excess of the choice they stand
 // in for (schedule_next_probe; with --time also of the seconds they took, set_times). On an image
 // of more than kProbePixels pixels a probe records one pixel per block of the image and the
@@ -164,7 +165,7 @@ class AdaptivePlan {
   static constexpr double kSparseProbeLightPaths = 0.5;
   // Probes are iterations 0 and 1, then each after the iterations since the last one have cost
   // (predicted) what everything before it did (schedule_next_probe): with one cost per
-  // iteration, iterations 3, 7, 15, 31, ...
+  // iteration, iterations 3, 7, 15, 31, ... while the choice changes (settled_choices_).
   static constexpr int kFirstProbes = 2;
   static constexpr int kPoolRadius = 3;  // pixel statistics pooled over 7 x 7 (box_blur)
   // What recording every contribution for every candidate adds to a probe's pixels (measured on
@@ -173,6 +174,9 @@ class AdaptivePlan {
   static constexpr double kProbeRecordingFactor = 1.78;
   // The most of the predicted time that the probes may take beyond the choice they replace.
   static constexpr double kMaxProbeShare = 0.1;
+  // A choice repeats the last one where the candidate is the same and at most this share of
+  // the pixels changed mode (settled_choices_, schedule_next_probe).
+  static constexpr double kSettledChange = 0.05;
   int probe_stride() const { return int(stride_); }
 
   bool is_probe(uint32_t iteration) const;
@@ -447,7 +451,8 @@ class AdaptivePlan {
   uint64_t next_probe_ = kFirstProbes;
   std::vector<uint64_t> probe_iterations_;
   double spent_cost_ = 0, last_choice_cost_ = 0, probe_excess_ = 0;
-  double probe_cost_ = 0;  // a probe's predicted microseconds per pixel (choose)
+  double probe_cost_ = 0;    // a probe's predicted microseconds per pixel (choose)
+  int settled_choices_ = 0;  // how many choices in a row repeated the one before (take_choice)
   double budget_iterations_ = 0, budget_seconds_ = 0, elapsed_seconds_ = 0;  // set_budget
   // set_times: the probes' wall seconds, the last probe's, and the last segment's per iteration
   // (0: no iteration since the previous probe).

@@ -173,7 +173,7 @@ void AdaptivePlan::schedule_next_probe() {
     // of 20 s at the scenes' own resolutions where the choice was cheap.
     const double rest = remaining_cost(probe, choice);
     if ((std::isfinite(rest) && probe_excess_ + std::max(0.0, probe_cost - choice) >
-                                    kMaxProbeShare * (spent_cost_ + rest)) ||
+                                    probe_share() * (spent_cost_ + rest)) ||
         probe_seconds_exceed_share(choice, segment_choice, probe_cost))
       gap = std::numeric_limits<uint32_t>::max();
   }
@@ -206,7 +206,7 @@ bool AdaptivePlan::probe_seconds_exceed_share(double choice, double segment_choi
                                : last_probe_seconds_ * choice / probe_cost;
   const double excess = std::max(0.0, probe_seconds_ - double(probes_) * iteration);
   const double next = std::max(0.0, last_probe_seconds_ - iteration);
-  return excess + next > kMaxProbeShare * budget_seconds_;
+  return excess + next > probe_share() * budget_seconds_;
 }
 
 double AdaptivePlan::remaining_cost(uint64_t probe, double choice) const {

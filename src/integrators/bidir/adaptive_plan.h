@@ -310,6 +310,9 @@ class AdaptivePlan {
   // scaled by the model from its choice (predicted cost `segment_choice`) to this one, or
   // before any segment the last probe's at the model's ratio (`probe_cost`).
   bool probe_seconds_exceed_share(double choice, double segment_choice, double probe_cost) const;
+  // The probes' bound: kMaxProbeShare, divided by k + 1 after a choice that repeated the one
+  // before k times in a row (settled_choices_), as the wait for the next probe is multiplied.
+  double probe_share() const { return kMaxProbeShare / double(1 + settled_choices_); }
   // Reports the last choice's measured and predicted relative variances (finish_probe).
   void check_last_choice(const std::vector<double>& measured, double iterations,
                          double thread_seconds, const std::vector<float>& means);

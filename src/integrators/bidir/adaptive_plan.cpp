@@ -120,14 +120,21 @@ AdaptivePlan::AdaptivePlan(int width, int height, bool measured_costs, bool prob
   roulette_.fill(1.0);
 }
 
+std::vector<size_t> AdaptivePlan::grid_image_pixels() const {
+  std::vector<size_t> pixels(grid_pixels_);
+  for (int gy = 0; gy < grid_h_; ++gy)
+    for (int gx = 0; gx < grid_w_; ++gx)
+      pixels[size_t(gy) * grid_w_ + gx] =
+          size_t(gy * stride_ + offset_) * width_ + (gx * stride_ + offset_);
+  return pixels;
+}
+
 template <typename T>
 std::vector<T> AdaptivePlan::on_grid(const std::vector<T>& image) const {
   if (stride_ == 1 || image.size() != pixels_) return image;
+  const std::vector<size_t> pixels = grid_image_pixels();
   std::vector<T> grid(grid_pixels_);
-  for (int gy = 0; gy < grid_h_; ++gy)
-    for (int gx = 0; gx < grid_w_; ++gx)
-      grid[size_t(gy) * grid_w_ + gx] =
-          image[size_t(gy * stride_ + offset_) * width_ + (gx * stride_ + offset_)];
+  for (size_t g = 0; g < grid_pixels_; ++g) grid[g] = image[pixels[g]];
   return grid;
 }
 
@@ -428,8 +435,8 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   for (size_t p = 0; p < grid_pixels_; ++p)
     mean_square_sums_[p] += double(grid_means[p]) * double(probe_estimate_[p]);
   ++mean_square_probes_;
-  if (measured.size() == pixels_ && chosen_j_ < kCandidates)
-    check_last_choice(on_grid(measured), iterations, thread_seconds, grid_means);
+  if (measured.size() == grid_pixels_ && chosen_j_ < kCandidates)
+    check_last_choice(measured, iterations, thread_seconds, grid_means);
   // A choice needs the film's means (from the iterations before the probe) and two probes.
   if (probes_ >= kFirstProbes || probe_all_) choose(grid_means);
   if (probes_ >= kFirstProbes) schedule_next_probe();

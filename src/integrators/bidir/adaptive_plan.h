@@ -178,6 +178,9 @@ class AdaptivePlan {
   // the pixels changed mode (settled_choices_, schedule_next_probe).
   static constexpr double kSettledChange = 0.05;
   int probe_stride() const { return int(stride_); }
+  // The image pixel of each grid pixel (those a probe records), in grid order: the pixels whose
+  // segment moments finish_probe reads (SegmentMoments::reset).
+  std::vector<size_t> grid_image_pixels() const;
 
   bool is_probe(uint32_t iteration) const;
   // The render's budget, before each probe is finished: iterations (a fixed --spp) or seconds
@@ -244,7 +247,7 @@ class AdaptivePlan {
   void pixel_end(size_t pixel, const CandidateSums& sums, double camera_vertices = 0);
   // After a probe: its work, and the pixel means of the iterations before it (empty after the
   // first; a mean from the probes alone makes a single sample look noiseless); re-optimises.
-  // measured: per pixel, the variance of one iteration's estimate measured over the
+  // measured: per grid pixel (grid_image_pixels), the variance of one iteration's estimate over the
   // `iterations` iterations since the previous probe, which rendered the last choice
   // (SegmentMoments; empty if fewer than two): reported beside what was predicted for that
   // choice ("checks"), not used to choose. A few iterations measure a heavy tail low (13 scenes

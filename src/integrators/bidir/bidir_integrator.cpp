@@ -97,7 +97,7 @@ void BidirIntegrator::prepare(const Scene& scene, Film& film) {
   if (tech_.adaptive && !techniques_.enabled())
     path_tracer_ = std::make_unique<PathTracer>(settings_);
   if (tech_.adaptive) {
-    segment_.reset(film.pixel_count());
+    segment_.reset(plan_.grid_image_pixels());
     segment_thread_seconds_ = 0;
     segment_iterations_ = 0;
   }

@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <utility>
 
 #include "film/film.h"
 
@@ -16,9 +17,10 @@ FixedSum channels(std::span<const FixedSum> totals, size_t p) {
 }
 }  // namespace
 
-void SegmentMoments::reset(size_t pixels) {
-  before_.assign(pixels, 0);
-  sums_.assign(2 * pixels + 1, 0);
+void SegmentMoments::reset(std::vector<size_t> pixels) {
+  pixels_ = std::move(pixels);
+  before_.assign(pixels_.size(), 0);
+  sums_.assign(2 * pixels_.size() + 1, 0);
 }
 
 void SegmentMoments::clear() { std::fill(sums_.begin(), sums_.end(), FixedSum(0)); }
@@ -26,7 +28,7 @@ void SegmentMoments::clear() { std::fill(sums_.begin(), sums_.end(), FixedSum(0)
 void SegmentMoments::begin_iteration(const Film& film) {
   const std::span<const FixedSum> totals = film.sums();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, before_.size(), 4096), [&](const auto& r) {
-    for (size_t p = r.begin(); p != r.end(); ++p) before_[p] = channels(totals, p);
+    for (size_t i = r.begin(); i != r.end(); ++i) before_[i] = channels(totals, pixels_[i]);
   });
 }
 
@@ -34,11 +36,11 @@ void SegmentMoments::end_iteration(const Film& film) {
   const std::span<const FixedSum> totals = film.sums();
   // Each pixel is its own: the split over threads changes no sum.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, before_.size(), 4096), [&](const auto& r) {
-    for (size_t p = r.begin(); p != r.end(); ++p) {
-      const FixedSum v3 = channels(totals, p) - before_[p];
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const FixedSum v3 = channels(totals, pixels_[i]) - before_[i];
       const double v = from_fixed(v3) / 3.0;
-      sums_[2 * p] += v3;
-      sums_[2 * p + 1] += to_fixed(v * v);  // clamped at 2^31 (fixed_sum.h)
+      sums_[2 * i] += v3;
+      sums_[2 * i + 1] += to_fixed(v * v);  // clamped at 2^31 (fixed_sum.h)
     }
   });
   sums_.back() += to_fixed(1.0);

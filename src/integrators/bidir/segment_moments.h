@@ -22,23 +22,25 @@ namespace caustica::bidir {
 
 class SegmentMoments {
  public:
-  // Zeroed sums for a film of `pixels` pixels.
-  void reset(size_t pixels);
+  // Zeroed sums for the film's pixels listed in `pixels` (adaptive-vcm's probed grid: only
+  // those are checked against a prediction, and on a large image they are one in stride^2).
+  void reset(std::vector<size_t> pixels);
   // Around one iteration that renders the current choice.
   void begin_iteration(const Film& film);
   void end_iteration(const Film& film);
-  // Per pixel the sums of v and v^2 (v: the scalar estimate, the mean of the channels), then
-  // the number of iterations: the layout variances() reads, to be summed over ranks.
+  // Per listed pixel the sums of v and v^2 (v: the scalar estimate, the mean of the channels),
+  // then the number of iterations: the layout variances() reads, to be summed over ranks.
   std::span<FixedSum> sums() { return sums_; }
   // Zero the sums (a new choice begins).
   void clear();
-  // Per pixel, from sums (this process's or summed over ranks): the unbiased variance of one
+  // Per listed pixel, from sums (this process's or summed over ranks): the unbiased variance of one
   // iteration's estimate, from the sample variance of the segment's M iterations; empty when
   // M < 2. *iterations: M.
   static std::vector<double> variances(std::span<const FixedSum> sums, double* iterations);
 
  private:
-  std::vector<FixedSum> before_;  // per pixel: the film's three channel totals, added
+  std::vector<size_t> pixels_;    // the film's pixels measured
+  std::vector<FixedSum> before_;  // per listed pixel: the film's three channel totals, added
   std::vector<FixedSum> sums_;
 };
 

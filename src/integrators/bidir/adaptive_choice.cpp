@@ -252,16 +252,25 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
                      {"predicted_us_per_pixel", chosen_cost_}});
 }
 
-double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<float>& means,
-                                       Half half) const {
+double AdaptivePlan::square(size_t p, size_t j, const std::vector<float>& means, Half half) const {
   // Path tracing's estimate there has the mean of the paths it makes (pt_missing_): (mu - miss)^2.
   // The halves (cross-fitting) keep the film's m^2: with one probe each at the first choice, the
   // square of the mean of a different probe made their variances too noisy to pick modes on
   // (cornell-glass 48 x 48 stopped merging on its glass sphere), and the optimism they measure
   // is a difference between two of them, where the common bias cancels.
   const double m = means[p], miss = j == 0 ? pt_missing_[p] / double(probes_) : 0.0;
-  const double square =
-      (half == Half::All ? mean_square(p, m) : m * m) - 2 * m * miss + miss * miss;
+  return (half == Half::All ? mean_square(p, m) : m * m) - 2 * m * miss + miss * miss;
+}
+
+std::vector<double> AdaptivePlan::squares(const std::vector<float>& means, Half half) const {
+  std::vector<double> out(grid_pixels_);
+  for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p) out[p] = square(p, 1, means, half);
+  });
+  return out;
+}
+
+inline double AdaptivePlan::relative_variance(size_t p, size_t j, double square, Half half) const {
   const size_t i = (p * kCandidates + j) * 3;
   const double all = get_float24(&moments_[i]);
   const int odd_probes = probes_ / 2;
@@ -271,6 +280,22 @@ double AdaptivePlan::relative_variance(size_t p, size_t j, const std::vector<flo
                             : (all - get_float24(&moments_odd_[i])) / double(probes_ - odd_probes);
   // Signed: clamped only after pooling (relative_variances).
   return (moment - square) / denominator_[p] * roulette_[j];
+}
+
+void AdaptivePlan::relative_variance_rows(size_t first, size_t count, size_t sets,
+                                          const std::vector<float>& means,
+                                          const std::array<std::vector<double>, 3>& squares,
+                                          Rows& out) const {
+  constexpr std::array<Half, 3> halves{Half::All, Half::Even, Half::Odd};
+  for (size_t h = 0; h < sets; ++h)
+    for (size_t k = 0; k < count; ++k) out[h][k].resize(grid_pixels_);
+  for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p)
+      for (size_t h = 0; h < sets; ++h)
+        for (size_t k = 0, j = first; k < count; ++k, ++j)
+          out[h][k][p] = relative_variance(
+              p, j, j == 0 ? square(p, 0, means, halves[h]) : squares[h][p], halves[h]);
+  });
 }
 
 std::vector<double> AdaptivePlan::denominators(const std::vector<float>& means) const {
@@ -366,7 +391,8 @@ double AdaptivePlan::path_tracing_bias_weight(const PixelWork& pw, const CostMod
   return std::min(n, double(probe + 1) + rest / (seconds_per_cost * pt_cost));
 }
 
-void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
+void AdaptivePlan::update_roulette_factors(const std::vector<float>& means,
+                                           const std::vector<double>& squares) {
   roulette_.fill(1.0);
   // Per candidate (in parallel; each in pixel order, so deterministic): its relative variance
   // and the relative roulette difference per pixel, both pooled over 7 x 7 as the variances
@@ -378,16 +404,17 @@ void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
   // most of the image's variance. That sum swamped the +40% of every other pixel (a factor of
   // 1.00 instead of 1.42 for two light paths per pixel without connections, whose choice then
   // rendered 1.5x its prediction).
-  tbb::parallel_for(size_t(0), kCandidates, [&](size_t j) {
-    std::vector<double> variance(grid_pixels_), diff(grid_pixels_);
-    for (size_t p = 0; p < grid_pixels_; ++p) {
-      variance[p] = j == 0 && pt_missing_[p] != 0 ? std::numeric_limits<double>::infinity()
-                                                  : relative_variance(p, j, means);
+  // In chunks of kRowCandidates candidates, whose moments each pixel keeps side by side.
+  const auto roulette_of = [&](size_t j, std::vector<double>& variance) {
+    if (j == 0)
+      for (size_t p = 0; p < grid_pixels_; ++p)
+        if (pt_missing_[p] != 0) variance[p] = std::numeric_limits<double>::infinity();
+    std::vector<double> diff(grid_pixels_);
+    for (size_t p = 0; p < grid_pixels_; ++p)
       diff[p] = std::isfinite(variance[p])
                     ? get_float24(&roulette_diff_[(p * kCandidates + j) * 3]) /
                           (double(probes_) * denominator_[p])
                     : 0.0;
-    }
     variance = box_blur(variance, grid_w_, grid_h_, kPoolRadius);
     diff = box_blur(diff, grid_w_, grid_h_, kPoolRadius);
     std::vector<double> ratio;
@@ -401,11 +428,18 @@ void AdaptivePlan::update_roulette_factors(const std::vector<float>& means) {
     for (double r : ratio) sum += std::max(-1.0, std::min(r, cap));  // cap may lie below -1
     const double factor = 1.0 + sum / double(ratio.size());
     roulette_[j] = std::isfinite(factor) ? std::max(factor, 1.0) : 1.0;
+  };
+  const std::array<std::vector<double>, 3> all_squares{squares, {}, {}};
+  tbb::parallel_for(size_t(0), (kCandidates + kRowCandidates - 1) / kRowCandidates, [&](size_t c) {
+    const size_t first = c * kRowCandidates, count = std::min(kRowCandidates, kCandidates - first);
+    Rows rows;
+    relative_variance_rows(first, count, 1, means, all_squares, rows);
+    for (size_t k = 0; k < count; ++k) roulette_of(first + k, rows[0][k]);
   });
 }
 
-std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<float>& means,
-                                                            Half half) const {
+std::vector<double> AdaptivePlan::shared_firefly_correction(
+    const std::vector<float>& means, Half half, const std::vector<double>& squares) const {
   // The part of a pixel's variance every candidate has (the least of them) is winsorised at its
   // 99.5th percentile over the pixels: a firefly that a few probes saw in a handful of pixels,
   // and that every candidate shares, is mostly estimation noise; at full weight it drowns the
@@ -414,10 +448,11 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
   std::vector<double> shared(grid_pixels_);
   for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p) {
-      double least = std::numeric_limits<double>::infinity();
       // Path tracing where it misses energy is out, as every candidate that does (infinite).
-      for (size_t j = pt_missing_[p] != 0 ? 1 : 0; j < kCandidates; ++j)
-        least = std::min(least, relative_variance(p, j, means, half));
+      double least = pt_missing_[p] != 0 ? std::numeric_limits<double>::infinity()
+                                         : relative_variance(p, 0, square(p, 0, means, half), half);
+      for (size_t j = 1; j < kCandidates; ++j)
+        least = std::min(least, relative_variance(p, j, squares[p], half));
       shared[p] = least;
     }
   });
@@ -429,19 +464,19 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(const std::vector<fl
   return shared;
 }
 
-std::vector<double> AdaptivePlan::relative_variances(
-    size_t j, const std::vector<float>& means, const std::vector<double>& correction, Half half,
-    const std::vector<double>* pooled_extra) const {
-  std::vector<double> v(grid_pixels_);
-  for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
-    for (size_t p = begin; p < end; ++p)
-      v[p] = relative_variance(p, j, means, half) + correction[p];
-  });
-  v = box_blur(v, grid_w_, grid_h_, kPoolRadius);
-  for (double& x : v) x = std::max(x, 0.0);  // inf stays inf
-  if (pooled_extra)
-    for (size_t p = 0; p < grid_pixels_; ++p) v[p] += (*pooled_extra)[p];
-  return v;
+void AdaptivePlan::relative_variances(size_t first, size_t count, size_t sets,
+                                      const std::vector<float>& means,
+                                      const std::array<std::vector<double>, 3>& squares,
+                                      const std::array<std::vector<double>, 3>& correction,
+                                      Rows& out) const {
+  relative_variance_rows(first, count, sets, means, squares, out);
+  for (size_t h = 0; h < sets; ++h)
+    for (size_t k = 0; k < count; ++k) {
+      std::vector<double>& v = out[h][k];
+      for (size_t p = 0; p < grid_pixels_; ++p) v[p] += correction[h][p];
+      v = box_blur(v, grid_w_, grid_h_, kPoolRadius);
+      for (double& x : v) x = std::max(x, 0.0);  // inf stays inf
+    }
 }
 
 std::vector<double> AdaptivePlan::pixel_cost_weights() const {
@@ -460,24 +495,27 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   const PixelWork pw = pixel_work_of(work_, double(probes_), pixels, kProbeConnections);
   const CostModel t = costs_of(work_, measured_);
   denominator_ = denominators(means);
-  update_roulette_factors(means);
-  const std::vector<double> weights = pixel_cost_weights();
   // Every probe, then the even and the odd ones alone (cross-fitting needs one in each).
   const bool cross = probes_ >= 2;
   const std::array<Half, 3> halves{Half::All, Half::Even, Half::Odd};
   const size_t sets = cross ? 3 : 1;
-  std::array<std::vector<double>, 3> correction, pt;
-  // Photon mapping per light-path factor (kLightPathFactors' order).
-  std::array<std::array<std::vector<double>, kStopCandidates>, 3> stop;
+  std::array<std::vector<double>, 3> squares_of;  // the squares per half (squares())
+  for (size_t h = 0; h < sets; ++h) squares_of[h] = squares(means, halves[h]);
+  update_roulette_factors(means, squares_of[0]);
+  const std::vector<double> weights = pixel_cost_weights();
+  std::array<std::vector<double>, 3> correction;
+  // Path tracing, and photon mapping per light-path factor (kLightPathFactors' order).
+  Rows pt, stop;
   // Path tracing's bias where it misses energy, weighted by the iterations it would render.
   bias_iterations_ = path_tracing_bias_weight(pw, t);
   const std::vector<double> pt_bias = path_tracing_bias(bias_iterations_, &relative_bias_sum_);
   for (size_t h = 0; h < sets; ++h) {
-    correction[h] = shared_firefly_correction(means, halves[h]);
-    pt[h] = relative_variances(0, means, correction[h], halves[h], &pt_bias);
-    for (size_t i = 0; i < kStopCandidates; ++i)
-      stop[h][i] = relative_variances(kCoreCandidates + i, means, correction[h], halves[h]);
+    correction[h] = shared_firefly_correction(means, halves[h], squares_of[h]);
   }
+  relative_variances(0, 1, sets, means, squares_of, correction, pt);
+  for (size_t h = 0; h < sets; ++h)
+    for (size_t p = 0; p < grid_pixels_; ++p) pt[h][0][p] += pt_bias[p];
+  relative_variances(kCoreCandidates, kStopCandidates, sets, means, squares_of, correction, stop);
   // Path tracing is the default only among equals (kPathTracingMargin).
   Score best, path_tracing;
   size_t best_j = 0, best_variant = kMixed;
@@ -490,12 +528,14 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     const Candidate& c = list[j];
     const size_t si = j == 0 ? kStopCandidates : stop_index_of(c.light_path_factor);
     std::array<PairVariances, 3> v;
+    Rows pair;
+    if (j != 0) relative_variances(j, 2, sets, means, squares_of, correction, pair);
     for (size_t h = 0; h < sets; ++h) {
-      v[h].pt = &pt[h];
+      v[h].pt = &pt[h][0];
       v[h].stops = si < kStopCandidates ? &stop[h][si] : nullptr;
       if (j == 0) continue;
-      v[h].no_merge = relative_variances(j, means, correction[h], halves[h]);
-      v[h].merge = relative_variances(j + 1, means, correction[h], halves[h]);
+      v[h].no_merge = std::move(pair[h][0]);
+      v[h].merge = std::move(pair[h][1]);
     }
     const ModePrices price{base_cost(c, pw, t),
                            j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t),
@@ -505,8 +545,8 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
                            light_cost(c, pw, t, false),
                            &weights};
     PixelChoice choice =
-        j == 0 ? choose_modes(pt[0], pt[0], pt[0], nullptr, price, true)
-               : choose_modes(v[0].no_merge, v[0].merge, pt[0], v[0].stops, price, false);
+        j == 0 ? choose_modes(pt[0][0], pt[0][0], pt[0][0], nullptr, price, true)
+               : choose_modes(v[0].no_merge, v[0].merge, pt[0][0], v[0].stops, price, false);
     MixPrice mix;
     const std::array<Score, kVariants> scores =
         variant_scores(grid_pixels_, v, choice, price, cross, j == 0, mix);

@@ -1,6 +1,7 @@
 #include "integrators/bidir/adaptive_plan.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -438,7 +439,13 @@ void AdaptivePlan::finish_probe(const ProbeWork& w, const std::vector<float>& me
   if (measured.size() == grid_pixels_ && chosen_j_ < kCandidates)
     check_last_choice(measured, iterations, thread_seconds, grid_means);
   // A choice needs the film's means (from the iterations before the probe) and two probes.
-  if (probes_ >= kFirstProbes || probe_all_) choose(grid_means);
+  if (probes_ >= kFirstProbes || probe_all_) {
+    const auto start = std::chrono::steady_clock::now();
+    choose(grid_means);
+    // Not deterministic (a clock): what choosing took, beside the probe's rendering.
+    history_.back()["choice_seconds"] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   if (probes_ >= kFirstProbes) schedule_next_probe();
 }
 

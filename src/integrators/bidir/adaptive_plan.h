@@ -279,20 +279,34 @@ class AdaptivePlan {
   // (relative_variances clamps after pooling).
   // half: the estimate from every probe, or from the even or odd ones (0, 2, ... or 1, 3, ...)
   // alone (cross-fitting, choose()).
+  // square: the pixel's mean^2 that the second moment is reduced by (square()).
   enum class Half { All, Even, Odd };
-  double relative_variance(size_t p, size_t j, const std::vector<float>& means,
-                           Half half = Half::All) const;
-  // Sets roulette_ from the sums so far (see roulette_diff_).
-  void update_roulette_factors(const std::vector<float>& means);
+  double relative_variance(size_t p, size_t j, double square, Half half = Half::All) const;
+  // The mean^2 of pixel p that candidate j's variance subtracts from its second moment; the
+  // same for every candidate with light paths (j > 0), so choose() computes those once per
+  // pixel and half (squares()) instead of once per candidate.
+  double square(size_t p, size_t j, const std::vector<float>& means, Half half = Half::All) const;
+  std::vector<double> squares(const std::vector<float>& means, Half half) const;
+  // Sets roulette_ from the sums so far (see roulette_diff_); squares: squares(means, All).
+  void update_roulette_factors(const std::vector<float>& means, const std::vector<double>& squares);
   // Per pixel: what to add to every candidate's variance to winsorise the part they share.
-  std::vector<double> shared_firefly_correction(const std::vector<float>& means,
-                                                Half half = Half::All) const;
-  // Per pixel: candidate j's relative variance, corrected and pooled over neighbours.
-  // pooled_extra (path tracing's bias, path_tracing_bias): added after pooling.
-  std::vector<double> relative_variances(size_t j, const std::vector<float>& means,
-                                         const std::vector<double>& correction,
-                                         Half half = Half::All,
-                                         const std::vector<double>* pooled_extra = nullptr) const;
+  std::vector<double> shared_firefly_correction(const std::vector<float>& means, Half half,
+                                                const std::vector<double>& squares) const;
+  // Per-pixel values of up to kRowCandidates candidates under each half (All, Even, Odd).
+  static constexpr size_t kRowCandidates = kStopCandidates;
+  using Rows = std::array<std::array<std::vector<double>, kRowCandidates>, 3>;
+  // out[h][k][p]: relative_variance of candidate first + k at grid pixel p under the h-th half,
+  // for h < sets (squares[h]: squares(means, that half)). In one pass over the pixels, whose
+  // moments lie side by side per pixel: a pass per candidate and half read each pixel's cache
+  // line of the moments again (on material-testball, 384 x 216, most of a choice's time).
+  void relative_variance_rows(size_t first, size_t count, size_t sets,
+                              const std::vector<float>& means,
+                              const std::array<std::vector<double>, 3>& squares, Rows& out) const;
+  // The same, plus correction[h] (shared_firefly_correction), pooled over neighbours and
+  // clamped at 0.
+  void relative_variances(size_t first, size_t count, size_t sets, const std::vector<float>& means,
+                          const std::array<std::vector<double>, 3>& squares,
+                          const std::array<std::vector<double>, 3>& correction, Rows& out) const;
   // Scores every candidate from the probes so far and takes the best (adaptive_choice.cpp).
   void choose(const std::vector<float>& means);
   // Adds the choice just taken to the history: its option (variant), costs and candidate table.

@@ -265,7 +265,7 @@ double AdaptivePlan::square(size_t p, size_t j, const std::vector<float>& means,
 std::vector<double> AdaptivePlan::squares(const std::vector<float>& means, Half half) const {
   std::vector<double> out(grid_pixels_);
   for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
-    for (size_t p = begin; p < end; ++p) out[p] = square(p, 1, means, half);
+    for (size_t p = begin; p < end; ++p) out[p] = square(p, 1, means, half);  // any j > 0
   });
   return out;
 }

@@ -239,12 +239,36 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
     measured_total += sum[0];
     predicted_total += sum[1];
   }
+  // What the prediction missed by far (uncapped) where the pixel saw the camera pass alone:
+  // fireflies of events no probe sampled.
+  double unseen_total = 0;
+  if (unseen_sums_.empty()) {
+    unseen_sums_.assign(grid_pixels_, 0.0);
+    unseen_iterations_.assign(grid_pixels_, 0.0);
+  }
+  // Relative to the mean shrunk by the segment's variance too: a firefly raises its own
+  // pixel's mean as much as its variance.
+  const std::vector<double> shrunk = denominators(means, &measured);
+  std::vector<double> robust(grid_pixels_);
+  for (size_t p = 0; p < grid_pixels_; ++p) robust[p] = measured[p] / shrunk[p];
+  robust = box_blur(robust, grid_w_, grid_h_, kPoolRadius);
+  for (size_t p = 0; p < grid_pixels_; ++p) {
+    const PixelMode mode = chosen_grid_modes_[p];
+    if (mode != PixelMode::PathTrace && mode != PixelMode::Stop) continue;
+    unseen_iterations_[p] += iterations;
+    const double predicted = chosen_variance_[p];
+    if (!std::isfinite(predicted) || !std::isfinite(robust[p])) continue;
+    if (robust[p] <= kUnseenFactor * predicted) continue;
+    unseen_sums_[p] += (robust[p] - predicted) * iterations;
+    unseen_total += robust[p] - predicted;
+  }
   checks_.push_back({{"after_probe", probes_},
                      {"light_path_factor", candidates()[chosen_j_].light_path_factor},
                      {"connections", candidates()[chosen_j_].connections},
                      {"iterations", iterations},
                      {"measured_relative_variance", measured_total / double(grid_pixels_)},
                      {"predicted_relative_variance", predicted_total / double(grid_pixels_)},
+                     {"unseen_relative_variance", unseen_total / double(grid_pixels_)},
                      // Not deterministic (a clock); with the fixed cost model the two differ by
                      // the machine's speed, so compare their ratio across choices.
                      {"measured_us_per_pixel",
@@ -298,7 +322,8 @@ void AdaptivePlan::relative_variance_rows(size_t first, size_t count, size_t set
   });
 }
 
-std::vector<double> AdaptivePlan::denominators(const std::vector<float>& means) const {
+std::vector<double> AdaptivePlan::denominators(const std::vector<float>& means,
+                                               const std::vector<double>* rendered) const {
   std::vector<double> d(grid_pixels_);
   const double k = double(probes_), n = double(probe_iteration());
   if (k < 2 || !(n > 0)) {
@@ -317,7 +342,8 @@ std::vector<double> AdaptivePlan::denominators(const std::vector<float>& means) 
     // few probes happened to agree takes its neighbours'. (The film's iterations after the
     // first choice render the choice, not the probe: the probe's variance stands in.)
     const double noise =
-        kShrinkSigmas * kShrinkSigmas * std::max({own[p], pooled_variance[p], 0.0}) / n;
+        kShrinkSigmas * kShrinkSigmas *
+        std::max({own[p], pooled_variance[p], rendered ? (*rendered)[p] : 0.0, 0.0}) / n;
     const double diff = m[p] - pooled[p];
     const double keep = diff * diff > noise ? 1.0 - noise / (diff * diff) : 0.0;
     const double shrunk = pooled[p] + keep * diff;
@@ -470,13 +496,24 @@ void AdaptivePlan::relative_variances(size_t first, size_t count, size_t sets,
                                       const std::array<std::vector<double>, 3>& correction,
                                       Rows& out) const {
   relative_variance_rows(first, count, sets, means, squares, out);
+  const std::vector<double> unseen = unseen_variance();
   for (size_t h = 0; h < sets; ++h)
     for (size_t k = 0; k < count; ++k) {
       std::vector<double>& v = out[h][k];
       for (size_t p = 0; p < grid_pixels_; ++p) v[p] += correction[h][p];
       v = box_blur(v, grid_w_, grid_h_, kPoolRadius);
       for (double& x : v) x = std::max(x, 0.0);  // inf stays inf
+      if (!unseen.empty())
+        for (size_t p = 0; p < grid_pixels_; ++p) v[p] += unseen[p];
     }
+}
+
+std::vector<double> AdaptivePlan::unseen_variance() const {
+  if (unseen_sums_.empty()) return {};
+  std::vector<double> out(grid_pixels_, 0.0);
+  for (size_t p = 0; p < grid_pixels_; ++p)
+    if (unseen_iterations_[p] > 0) out[p] = unseen_sums_[p] / unseen_iterations_[p];
+  return out;
 }
 
 std::vector<double> AdaptivePlan::pixel_cost_weights() const {
@@ -583,6 +620,10 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   for (size_t p = 0; p < grid_pixels_; ++p)
     if (best_choice.modes[p] == PixelMode::PathTrace && std::isfinite(pt_bias[p]))
       chosen_variance_[p] -= pt_bias[p];
+  // Nor is the variance the probes did not predict: each check measures what it adds anew.
+  const std::vector<double> unseen = unseen_variance();
+  if (!unseen.empty())
+    for (size_t p = 0; p < grid_pixels_; ++p) chosen_variance_[p] -= unseen[p];
   chosen_cost_ = best_choice.cost / pixels;
   predict_probe_cost(pw, t);
   record_choice(kVariantNames[best_variant], t, std::move(table));
@@ -611,6 +652,7 @@ void AdaptivePlan::record_choice(const char* variant, const CostModel& t, nlohma
 
 void AdaptivePlan::take_choice(size_t j, const std::vector<PixelMode>& grid_modes) {
   const Candidate& c = candidates()[j];
+  chosen_grid_modes_ = grid_modes;
   // Each image pixel takes the mode of its block's probed pixel (the last row and column of
   // grid pixels also cover what is left of the image beyond them).
   size_t changed = 0;

@@ -177,6 +177,12 @@ class AdaptivePlan {
   // A choice repeats the last one where the candidate is the same and at most this share of
   // the pixels changed mode (settled_choices_, schedule_next_probe).
   static constexpr double kSettledChange = 0.05;
+  // Rendering a choice shows variance the probes did not predict (unseen_sums_) where its
+  // pooled relative variance exceeds the prediction by more than this factor: a prediction
+  // from two probes falls below a third of the truth in about one pixel in 4000 (15 of 65536
+  // in AdaptiveChoice.AFireflyThatNoProbeSawIsPricedIntoEveryCandidate), and a firefly of an
+  // event no probe sampled exceeds it many times over.
+  static constexpr double kUnseenFactor = 3.0;
   int probe_stride() const { return int(stride_); }
   // The image pixel of each grid pixel (those a probe records), in grid order: the pixels whose
   // segment moments finish_probe reads (SegmentMoments::reset).
@@ -250,11 +256,13 @@ class AdaptivePlan {
   // measured: per grid pixel (grid_image_pixels), the variance of one iteration's estimate over the
   // `iterations` iterations since the previous probe, which rendered the last choice
   // (SegmentMoments; empty if fewer than two): reported beside what was predicted for that
-  // choice ("checks"), not used to choose. A few iterations measure a heavy tail low (13 scenes
-  // at 160 pixels wide, 64 spp: measured / predicted 0.08-1.14 after 3 iterations, 0.80-1.26
-  // after 31 except water-caustic's 1.64), so a correction from them would keep a choice that
-  // happened to render well. thread_seconds: what those iterations took (wall seconds times
-  // threads), reported beside the cost predicted for the choice.
+  // choice ("checks"). A few iterations measure a heavy tail low (13 scenes at 160 pixels wide,
+  // 64 spp: measured / predicted 0.08-1.14 after 3 iterations, 0.80-1.26 after 31 except
+  // water-caustic's 1.64), so a correction from them would keep a choice that happened to
+  // render well; only what exceeds the prediction by far, where the camera pass alone makes
+  // the estimate, is priced into every candidate alike (unseen_sums_). thread_seconds: what
+  // those iterations took (wall seconds times threads), reported beside the cost predicted for
+  // the choice.
   void finish_probe(const ProbeWork& work, const std::vector<float>& means,
                     const std::vector<double>& measured = {}, double iterations = 0,
                     double thread_seconds = 0);
@@ -429,8 +437,12 @@ class AdaptivePlan {
   // with c = kShrinkSigmas standard errors, s^2 the variance of one probe's estimate there (the
   // larger of the pixel's own over the probes and its 7 x 7 pooled value) and n the film's
   // iterations. A pixel that stands out from its neighbours by more than that (an
-  // emitter's edge) keeps its own mean, and as n grows every pixel does.
-  std::vector<double> denominators(const std::vector<float>& means) const;
+  // emitter's edge) keeps its own mean, and as n grows every pixel does. With `rendered` (the
+  // per-iteration variance that a segment of the film showed, check_last_choice) s^2 is at
+  // least that: a firefly, which raises its pixel's mean as much as its variance, is shrunk
+  // away.
+  std::vector<double> denominators(const std::vector<float>& means,
+                                   const std::vector<double>* rendered = nullptr) const;
   std::vector<double> denominator_;
   // mean^2 for pixel p whose film mean is m: mean_square_sums_ / mean_square_probes_, or m^2.
   double mean_square(size_t p, double m) const;
@@ -486,6 +498,17 @@ class AdaptivePlan {
   // mode the pixel took), to check against what rendering it shows.
   size_t chosen_j_ = kCandidates;
   std::vector<double> chosen_variance_;
+  // Per grid pixel: the pooled relative variance per iteration that rendering a choice showed
+  // beyond its prediction where the pixel saw the camera pass's estimate alone (path tracing,
+  // photon mapping), and only where more than kUnseenFactor times it (check_last_choice),
+  // summed over those segments weighted by their iterations; and those iterations. Every
+  // candidate's variance there takes their mean (unseen_variance): the variance of events no
+  // probe sampled (a camera path that reaches a small light through specular bounces, on
+  // mirror-caustic), which each iteration's camera paths make whatever its configuration.
+  std::vector<double> unseen_sums_, unseen_iterations_;
+  std::vector<PixelMode> chosen_grid_modes_;  // the last choice's, per grid pixel
+  // The mean of unseen_sums_ per grid pixel (empty before any segment).
+  std::vector<double> unseen_variance() const;
   double chosen_cost_ = 0;              // its predicted microseconds per pixel and iteration
   std::vector<nlohmann::json> checks_;  // one per check_last_choice(), for the report
   std::vector<nlohmann::json> history_;

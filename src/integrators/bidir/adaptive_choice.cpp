@@ -19,8 +19,6 @@
 namespace caustica::bidir {
 
 namespace {
-constexpr double kRelEps = 0.01;      // as the relMSE metric (image/metrics.h)
-constexpr double kWinsorize = 0.995;  // quantile of pixel variances kept (relative_variances)
 // A pixel's film mean is kept where it differs from its pooled mean by more than this many of
 // its standard errors (AdaptivePlan::denominators, the positive-part James-Stein factor).
 constexpr double kShrinkSigmas = 2.0;
@@ -213,68 +211,6 @@ std::array<Score, kVariants> variant_scores(size_t n, const std::array<PairVaria
   return scores;
 }
 }  // namespace
-
-void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double iterations,
-                                     double thread_seconds, const std::vector<float>& means) {
-  // The measured relative variance, pooled as the prediction was; both capped at the
-  // prediction's 99.5th percentile, so that a firefly that one segment happened to render (or
-  // that the prediction's winsorising took out) does not decide the comparison alone.
-  std::vector<double> relative(grid_pixels_);
-  for (size_t p = 0; p < grid_pixels_; ++p)
-    relative[p] = measured[p] / (double(means[p]) * means[p] + kRelEps);
-  relative = box_blur(relative, grid_w_, grid_h_, kPoolRadius);
-  const double cap = finite_quantile(chosen_variance_, kWinsorize);
-  std::vector<std::array<double, 2>> blocks((grid_pixels_ + kPixelBlock - 1) / kPixelBlock);
-  for_pixel_blocks(grid_pixels_, [&](size_t b, size_t begin, size_t end) {
-    std::array<double, 2> sum{};
-    for (size_t p = begin; p < end; ++p) {
-      if (!std::isfinite(chosen_variance_[p]) || !std::isfinite(relative[p])) continue;
-      sum[0] += std::min(relative[p], cap);
-      sum[1] += std::min(chosen_variance_[p], cap);
-    }
-    blocks[b] = sum;
-  });
-  double measured_total = 0, predicted_total = 0;
-  for (const std::array<double, 2>& sum : blocks) {
-    measured_total += sum[0];
-    predicted_total += sum[1];
-  }
-  // What the prediction missed by far (uncapped) where the pixel saw the camera pass alone:
-  // fireflies of events no probe sampled.
-  double unseen_total = 0;
-  if (unseen_sums_.empty()) {
-    unseen_sums_.assign(grid_pixels_, 0.0);
-    unseen_iterations_.assign(grid_pixels_, 0.0);
-  }
-  // Relative to the mean shrunk by the segment's variance too: a firefly raises its own
-  // pixel's mean as much as its variance.
-  const std::vector<double> shrunk = denominators(means, &measured);
-  std::vector<double> robust(grid_pixels_);
-  for (size_t p = 0; p < grid_pixels_; ++p) robust[p] = measured[p] / shrunk[p];
-  robust = box_blur(robust, grid_w_, grid_h_, kPoolRadius);
-  for (size_t p = 0; p < grid_pixels_; ++p) {
-    const PixelMode mode = chosen_grid_modes_[p];
-    if (mode != PixelMode::PathTrace && mode != PixelMode::Stop) continue;
-    unseen_iterations_[p] += iterations;
-    const double predicted = chosen_variance_[p];
-    if (!std::isfinite(predicted) || !std::isfinite(robust[p])) continue;
-    if (robust[p] <= kUnseenFactor * predicted) continue;
-    unseen_sums_[p] += (robust[p] - predicted) * iterations;
-    unseen_total += robust[p] - predicted;
-  }
-  checks_.push_back({{"after_probe", probes_},
-                     {"light_path_factor", candidates()[chosen_j_].light_path_factor},
-                     {"connections", candidates()[chosen_j_].connections},
-                     {"iterations", iterations},
-                     {"measured_relative_variance", measured_total / double(grid_pixels_)},
-                     {"predicted_relative_variance", predicted_total / double(grid_pixels_)},
-                     {"unseen_relative_variance", unseen_total / double(grid_pixels_)},
-                     // Not deterministic (a clock); with the fixed cost model the two differ by
-                     // the machine's speed, so compare their ratio across choices.
-                     {"measured_us_per_pixel",
-                      iterations > 0 ? 1e6 * thread_seconds / (iterations * double(pixels_)) : 0.0},
-                     {"predicted_us_per_pixel", chosen_cost_}});
-}
 
 double AdaptivePlan::square(size_t p, size_t j, const std::vector<float>& means, Half half) const {
   // Path tracing's estimate there has the mean of the paths it makes (pt_missing_): (mu - miss)^2.
@@ -506,14 +442,6 @@ void AdaptivePlan::relative_variances(size_t first, size_t count, size_t sets,
       if (!unseen.empty())
         for (size_t p = 0; p < grid_pixels_; ++p) v[p] += unseen[p];
     }
-}
-
-std::vector<double> AdaptivePlan::unseen_variance() const {
-  if (unseen_sums_.empty()) return {};
-  std::vector<double> out(grid_pixels_, 0.0);
-  for (size_t p = 0; p < grid_pixels_; ++p)
-    if (unseen_iterations_[p] > 0) out[p] = unseen_sums_[p] / unseen_iterations_[p];
-  return out;
 }
 
 std::vector<double> AdaptivePlan::pixel_cost_weights() const {

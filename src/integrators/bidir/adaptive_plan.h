@@ -167,7 +167,10 @@ class AdaptivePlan {
   // (predicted) what everything before it did (schedule_next_probe): with one cost per
   // iteration, iterations 3, 7, 15, 31, ... while the choice changes (settled_choices_).
   static constexpr int kFirstProbes = 2;
-  static constexpr int kPoolRadius = 3;  // pixel statistics pooled over 7 x 7 (box_blur)
+  static constexpr int kPoolRadius = 3;    // pixel statistics pooled over 7 x 7 (box_blur)
+  static constexpr double kRelEps = 0.01;  // as the relMSE metric (image/metrics.h)
+  // The quantile of pixel variances kept (shared_firefly_correction, check_last_choice).
+  static constexpr double kWinsorize = 0.995;
   // What recording every contribution for every candidate adds to a probe's pixels (measured on
   // cornell-caustics 160x160, 1 thread: a probe 399 ms against 224 ms for vcm --connections 2,
   // docs/adaptive-vcm.md "What a probe costs").
@@ -339,9 +342,14 @@ class AdaptivePlan {
   // The probes' bound: kMaxProbeShare, divided by k + 1 after a choice that repeated the one
   // before k times in a row (settled_choices_), as the wait for the next probe is multiplied.
   double probe_share() const { return kMaxProbeShare / double(1 + settled_choices_); }
-  // Reports the last choice's measured and predicted relative variances (finish_probe).
+  // Reports the last choice's measured and predicted relative variances (finish_probe;
+  // adaptive_checks.cpp).
   void check_last_choice(const std::vector<double>& measured, double iterations,
                          double thread_seconds, const std::vector<float>& means);
+  // Adds what the segment `measured` showed beyond the prediction to unseen_sums_; returns it
+  // per grid pixel.
+  double add_unseen(const std::vector<double>& measured, double iterations,
+                    const std::vector<float>& means);
 
   size_t pixels_ = 0;  // the image's
   int width_ = 0, height_ = 0;

@@ -25,6 +25,25 @@ constexpr double kMoment = 2.0;  // of every candidate's estimate; its mean is 1
 // The relative variance every candidate has: (E[F^2] - mean^2) / (mean^2 + 0.01).
 constexpr double kTruth = (kMoment - 1.0) / (1.0 + 0.01);
 
+// One synthetic probe (synthetic_choice's) recorded into `plan`; returns its work, to finish it.
+ProbeWork record_synthetic_probe(AdaptivePlan& plan, std::mt19937& rng) {
+  const size_t pixels = size_t(kWidth) * kHeight;
+  std::exponential_distribution<float> moment(float(1.0 / kMoment));
+  plan.begin_probe(0.1f);
+  for (size_t p = 0; p < pixels; ++p) {
+    AdaptivePlan::CandidateSums sums;  // r = s0 = s1 = 0: the moment is d
+    for (float& d : sums.d) d = moment(rng);
+    sums.estimate = 1.f;  // the probe's own estimate: the mean (the square the moment loses)
+    plan.pixel_end(p, sums);
+  }
+  ProbeWork w;
+  w.light_paths = double(pixels);
+  w.light_vertices = 2.0 * double(pixels);
+  w.camera_vertices = w.nondelta_camera_vertices = 2.0 * double(pixels);
+  w.stop_camera_vertices = 20.0 * double(pixels);
+  return w;
+}
+
 // `probes` synthetic probes: per pixel and candidate an independent second moment drawn from an
 // exponential distribution of mean kMoment, with the work of two camera vertices and one light
 // path per pixel, no connections or merge queries (so that merging costs nothing extra and the
@@ -33,23 +52,10 @@ constexpr double kTruth = (kMoment - 1.0) / (1.0 + 0.01);
 nlohmann::json synthetic_choice(int probes, uint32_t seed) {
   AdaptivePlan plan(kWidth, kHeight, /*measured_costs=*/false, /*probe_every_iteration=*/false,
                     /*probe_stride=*/1);
-  const size_t pixels = size_t(kWidth) * kHeight;
-  const std::vector<float> means(pixels, 1.f);
+  const std::vector<float> means(size_t(kWidth) * kHeight, 1.f);
   std::mt19937 rng(seed);
-  std::exponential_distribution<float> moment(float(1.0 / kMoment));
   for (int probe = 0; probe < probes; ++probe) {
-    plan.begin_probe(0.1f);
-    for (size_t p = 0; p < pixels; ++p) {
-      AdaptivePlan::CandidateSums sums;  // r = s0 = s1 = 0: the moment is d
-      for (float& d : sums.d) d = moment(rng);
-      sums.estimate = 1.f;  // the probe's own estimate: the mean (the square the moment loses)
-      plan.pixel_end(p, sums);
-    }
-    ProbeWork w;
-    w.light_paths = double(pixels);
-    w.light_vertices = 2.0 * double(pixels);
-    w.camera_vertices = w.nondelta_camera_vertices = 2.0 * double(pixels);
-    w.stop_camera_vertices = 20.0 * double(pixels);
+    const ProbeWork w = record_synthetic_probe(plan, rng);
     plan.finish_probe(w, probe == 0 ? std::vector<float>{} : means);
   }
   nlohmann::json stats;
@@ -163,22 +169,9 @@ nlohmann::json after_a_segment(const std::vector<float>& means, const std::vecto
                                int force_mode = -1) {
   AdaptivePlan plan(kWidth, kHeight, /*measured_costs=*/false, /*probe_every_iteration=*/false,
                     /*probe_stride=*/1, force_mode);
-  const size_t pixels = size_t(kWidth) * kHeight;
   std::mt19937 rng(5);
-  std::exponential_distribution<float> moment(float(1.0 / kMoment));
   for (int probe = 0; probe < 3; ++probe) {
-    plan.begin_probe(0.1f);
-    for (size_t p = 0; p < pixels; ++p) {
-      AdaptivePlan::CandidateSums sums;
-      for (float& d : sums.d) d = moment(rng);
-      sums.estimate = 1.f;
-      plan.pixel_end(p, sums);
-    }
-    ProbeWork w;
-    w.light_paths = double(pixels);
-    w.light_vertices = 2.0 * double(pixels);
-    w.camera_vertices = w.nondelta_camera_vertices = 2.0 * double(pixels);
-    w.stop_camera_vertices = 20.0 * double(pixels);
+    const ProbeWork w = record_synthetic_probe(plan, rng);
     if (probe < 2)
       plan.finish_probe(w, probe == 0 ? std::vector<float>{} : means);
     else

@@ -430,9 +430,8 @@ void AdaptivePlan::relative_variances(size_t first, size_t count, size_t sets,
                                       const std::vector<float>& means,
                                       const std::array<std::vector<double>, 3>& squares,
                                       const std::array<std::vector<double>, 3>& correction,
-                                      Rows& out) const {
+                                      const std::vector<double>& unseen, Rows& out) const {
   relative_variance_rows(first, count, sets, means, squares, out);
-  const std::vector<double> unseen = unseen_variance();
   for (size_t h = 0; h < sets; ++h)
     for (size_t k = 0; k < count; ++k) {
       std::vector<double>& v = out[h][k];
@@ -468,6 +467,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   for (size_t h = 0; h < sets; ++h) squares_of[h] = squares(means, halves[h]);
   update_roulette_factors(means, squares_of[0]);
   const std::vector<double> weights = pixel_cost_weights();
+  const std::vector<double> unseen = unseen_variance();  // every candidate's (check_last_choice)
   std::array<std::vector<double>, 3> correction;
   // Path tracing, and photon mapping per light-path factor (kLightPathFactors' order).
   Rows pt, stop;
@@ -477,10 +477,11 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   for (size_t h = 0; h < sets; ++h) {
     correction[h] = shared_firefly_correction(means, halves[h], squares_of[h]);
   }
-  relative_variances(0, 1, sets, means, squares_of, correction, pt);
+  relative_variances(0, 1, sets, means, squares_of, correction, unseen, pt);
   for (size_t h = 0; h < sets; ++h)
     for (size_t p = 0; p < grid_pixels_; ++p) pt[h][0][p] += pt_bias[p];
-  relative_variances(kCoreCandidates, kStopCandidates, sets, means, squares_of, correction, stop);
+  relative_variances(kCoreCandidates, kStopCandidates, sets, means, squares_of, correction, unseen,
+                     stop);
   // Path tracing is the default only among equals (kPathTracingMargin).
   Score best, path_tracing;
   size_t best_j = 0, best_variant = kMixed;
@@ -494,7 +495,7 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     const size_t si = j == 0 ? kStopCandidates : stop_index_of(c.light_path_factor);
     std::array<PairVariances, 3> v;
     Rows pair;
-    if (j != 0) relative_variances(j, 2, sets, means, squares_of, correction, pair);
+    if (j != 0) relative_variances(j, 2, sets, means, squares_of, correction, unseen, pair);
     for (size_t h = 0; h < sets; ++h) {
       v[h].pt = &pt[h][0];
       v[h].stops = si < kStopCandidates ? &stop[h][si] : nullptr;
@@ -549,7 +550,6 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     if (best_choice.modes[p] == PixelMode::PathTrace && std::isfinite(pt_bias[p]))
       chosen_variance_[p] -= pt_bias[p];
   // Nor is the variance the probes did not predict: each check measures what it adds anew.
-  const std::vector<double> unseen = unseen_variance();
   if (!unseen.empty())
     for (size_t p = 0; p < grid_pixels_; ++p) chosen_variance_[p] -= unseen[p];
   chosen_cost_ = best_choice.cost / pixels;

@@ -315,10 +315,11 @@ class AdaptivePlan {
                               const std::vector<float>& means,
                               const std::array<std::vector<double>, 3>& squares, Rows& out) const;
   // The same, plus correction[h] (shared_firefly_correction), pooled over neighbours and
-  // clamped at 0.
+  // clamped at 0, plus `unseen` (unseen_variance; empty: none).
   void relative_variances(size_t first, size_t count, size_t sets, const std::vector<float>& means,
                           const std::array<std::vector<double>, 3>& squares,
-                          const std::array<std::vector<double>, 3>& correction, Rows& out) const;
+                          const std::array<std::vector<double>, 3>& correction,
+                          const std::vector<double>& unseen, Rows& out) const;
   // Scores every candidate from the probes so far and takes the best (adaptive_choice.cpp).
   void choose(const std::vector<float>& means);
   // Adds the choice just taken to the history: its option (variant), costs and candidate table.

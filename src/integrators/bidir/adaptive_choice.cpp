@@ -99,15 +99,24 @@ double variant_pixel_cost(size_t variant, const ModePrices& price) {
                                 : price.stopped;
 }
 
-// Every pixel in the one mode of `variant` (the candidate's options beside its per-pixel mix).
-PixelChoice uniform_choice(const PairVariances& v, size_t variant, const ModePrices& price) {
+// The sums of every pixel in the one mode of `variant` (the candidate's options beside its
+// per-pixel mix): variance, cost and missing pixels, without the per-pixel vectors.
+PixelChoice uniform_sums(const PairVariances& v, size_t variant, const ModePrices& price) {
+  const std::vector<double>& variances = *v.of(kVariantModes[variant]);
   PixelChoice out;
+  out.variance = finite_sum(variances.size(), [&](size_t p) { return variances[p]; });
+  for (size_t p = 0; p < variances.size(); ++p) {
+    out.missing += std::isfinite(variances[p]) ? 0.0 : 1.0;
+    out.cost += variant_pixel_cost(variant, price.at(p));
+  }
+  return out;
+}
+
+// Every pixel in the one mode of `variant`, with its per-pixel vectors (the option taken).
+PixelChoice uniform_choice(const PairVariances& v, size_t variant, const ModePrices& price) {
+  PixelChoice out = uniform_sums(v, variant, price);
   out.variances = *v.of(kVariantModes[variant]);
   out.modes.assign(out.variances.size(), kVariantModes[variant]);
-  out.variance = finite_sum(out.variances.size(), [&](size_t p) { return out.variances[p]; });
-  for (double x : out.variances) out.missing += std::isfinite(x) ? 0.0 : 1.0;
-  for (size_t p = 0; p < out.variances.size(); ++p)
-    out.cost += variant_pixel_cost(variant, price.at(p));
   return out;
 }
 
@@ -205,7 +214,7 @@ std::array<Score, kVariants> variant_scores(size_t n, const std::array<PairVaria
   if (path_tracing) return scores;  // every pixel path traces: no other option
   for (size_t k = kAllCore; k < kVariants; ++k) {
     if (!v[0].of(kVariantModes[k])) continue;
-    const PixelChoice all = uniform_choice(v[0], k, price);
+    const PixelChoice all = uniform_sums(v[0], k, price);
     scores[k] = {all.missing, all.variance * all.cost};
   }
   return scores;

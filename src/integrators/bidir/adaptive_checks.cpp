@@ -65,8 +65,10 @@ double AdaptivePlan::add_unseen(const std::vector<double>& measured, double iter
   std::vector<double> robust(grid_pixels_);
   for (size_t p = 0; p < grid_pixels_; ++p) robust[p] = measured[p] / shrunk[p];
   robust = box_blur(robust, grid_w_, grid_h_, kPoolRadius);
+  // The last choice's mode of each grid pixel is that of its image pixel (take_choice).
+  const std::vector<size_t> image_pixels = grid_image_pixels();
   for (size_t p = 0; p < grid_pixels_; ++p) {
-    const PixelMode mode = chosen_grid_modes_[p];
+    const PixelMode mode = modes_[image_pixels[p]];
     if (mode != PixelMode::PathTrace && mode != PixelMode::Stop) continue;
     unseen_iterations_[p] += iterations;
     const double predicted = chosen_variance_[p];

@@ -589,7 +589,6 @@ void AdaptivePlan::record_choice(const char* variant, const CostModel& t, nlohma
 
 void AdaptivePlan::take_choice(size_t j, const std::vector<PixelMode>& grid_modes) {
   const Candidate& c = candidates()[j];
-  chosen_grid_modes_ = grid_modes;
   // Each image pixel takes the mode of its block's probed pixel (the last row and column of
   // grid pixels also cover what is left of the image beyond them).
   size_t changed = 0;

@@ -515,7 +515,6 @@ class AdaptivePlan {
   // probe sampled (a camera path that reaches a small light through specular bounces, on
   // mirror-caustic), which each iteration's camera paths make whatever its configuration.
   std::vector<double> unseen_sums_, unseen_iterations_;
-  std::vector<PixelMode> chosen_grid_modes_;  // the last choice's, per grid pixel
   // The mean of unseen_sums_ per grid pixel (empty before any segment).
   std::vector<double> unseen_variance() const;
   double chosen_cost_ = 0;              // its predicted microseconds per pixel and iteration

@@ -298,8 +298,9 @@ TEST(PbrtSharedScenes, CornellCausticsLoadsAndProjectsLikePbrtV4) {
 }
 
 TEST(PbrtSharedScenes, EveryOwnSceneLoads) {
-  for (const char* name : {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic",
-                           "mis-plates", "point-room", "sun-glass"}) {
+  for (const char* name :
+       {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic", "mis-plates",
+        "point-room", "sun-glass", "spot-glass", "sky-spheres", "corner", "lamp"}) {
     SCOPED_TRACE(name);
     test::captured_warnings().clear();
     std::unique_ptr<Scene> scene;

@@ -1,14 +1,33 @@
 // What rendering a choice showed (AdaptivePlan::check_last_choice): the segment of iterations
 // between two probes, against the variance and cost predicted for the choice, and the variance
-// that no probe predicted (add_unseen), which every later choice prices into its candidates.
+// that no probe predicted (add_unseen), which every later choice prices into its candidates,
+// and the segments' variance against the probes' own, which weights the probes in the image
+// (probe_weight).
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "integrators/bidir/adaptive_plan.h"
 #include "integrators/bidir/grid_statistics.h"
 
 namespace caustica::bidir {
+
+namespace {
+// The mean over pixels of value[p] / denominator[p], over the finite ratios (NaN: none).
+double finite_mean(const std::vector<double>& value, const std::vector<double>& denominator) {
+  double sum = 0;
+  size_t n = 0;
+  for (size_t p = 0; p < value.size(); ++p) {
+    const double x = value[p] / denominator[p];
+    if (!std::isfinite(x)) continue;
+    sum += x;
+    ++n;
+  }
+  return n > 0 ? sum / double(n) : std::numeric_limits<double>::quiet_NaN();
+}
+}  // namespace
 
 void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double iterations,
                                      double thread_seconds, const std::vector<float>& means) {
@@ -35,7 +54,15 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
     measured_total += sum[0];
     predicted_total += sum[1];
   }
-  const double unseen_total = add_unseen(measured, iterations, means);
+  // Relative to the mean shrunk by the segment's variance too: a firefly raises its own
+  // pixel's mean as much as its variance.
+  const std::vector<double> shrunk = denominators(means, &measured);
+  const double unseen_total = add_unseen(measured, iterations, shrunk);
+  const double rendered = finite_mean(measured, shrunk);
+  if (std::isfinite(rendered)) {
+    rendered_relative_sum_ += rendered * iterations;
+    rendered_iterations_ += iterations;
+  }
   checks_.push_back({{"after_probe", probes_},
                      {"light_path_factor", candidates()[chosen_j_].light_path_factor},
                      {"connections", candidates()[chosen_j_].connections},
@@ -51,7 +78,7 @@ void AdaptivePlan::check_last_choice(const std::vector<double>& measured, double
 }
 
 double AdaptivePlan::add_unseen(const std::vector<double>& measured, double iterations,
-                                const std::vector<float>& means) {
+                                const std::vector<double>& shrunk) {
   // What the prediction missed by far (uncapped) where the pixel saw the camera pass alone:
   // fireflies of events no probe sampled.
   double total = 0;
@@ -59,9 +86,6 @@ double AdaptivePlan::add_unseen(const std::vector<double>& measured, double iter
     unseen_sums_.assign(grid_pixels_, 0.0);
     unseen_iterations_.assign(grid_pixels_, 0.0);
   }
-  // Relative to the mean shrunk by the segment's variance too: a firefly raises its own
-  // pixel's mean as much as its variance.
-  const std::vector<double> shrunk = denominators(means, &measured);
   std::vector<double> robust(grid_pixels_);
   for (size_t p = 0; p < grid_pixels_; ++p) robust[p] = measured[p] / shrunk[p];
   robust = box_blur(robust, grid_w_, grid_h_, kPoolRadius);
@@ -86,6 +110,24 @@ std::vector<double> AdaptivePlan::unseen_variance() const {
   for (size_t p = 0; p < grid_pixels_; ++p)
     if (unseen_iterations_[p] > 0) out[p] = unseen_sums_[p] / unseen_iterations_[p];
   return out;
+}
+
+AdaptivePlan::ProbeWeight AdaptivePlan::probe_weight(const std::vector<float>& image_means) const {
+  ProbeWeight w;
+  if (probes_ < 2 || !(rendered_iterations_ > 0)) return w;
+  const std::vector<float> means = on_grid(image_means);
+  if (means.size() != grid_pixels_) return w;
+  // One probe's variance per pixel: the unbiased spread of the probes' estimates.
+  const double k = double(probes_);
+  std::vector<double> own(grid_pixels_);
+  for (size_t p = 0; p < grid_pixels_; ++p)
+    own[p] = std::max(
+        (estimate_square_sums_[p] - estimate_sums_[p] * estimate_sums_[p] / k) / (k - 1), 0.0);
+  w.probe_relative_variance = finite_mean(own, denominators(means));
+  w.rendered_relative_variance = rendered_relative_sum_ / rendered_iterations_;
+  if (w.probe_relative_variance > 0 && std::isfinite(w.rendered_relative_variance))
+    w.weight = std::clamp(w.rendered_relative_variance / w.probe_relative_variance, 0.0, 1.0);
+  return w;
 }
 
 }  // namespace caustica::bidir

@@ -138,6 +138,7 @@ std::vector<T> AdaptivePlan::on_grid(const std::vector<T>& image) const {
   for (size_t g = 0; g < grid_pixels_; ++g) grid[g] = image[pixels[g]];
   return grid;
 }
+template std::vector<float> AdaptivePlan::on_grid(const std::vector<float>&) const;
 
 bool AdaptivePlan::is_probe(uint32_t iteration) const {
   return probe_all_ || iteration < kFirstProbes || iteration == next_probe_;

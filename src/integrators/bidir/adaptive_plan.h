@@ -276,6 +276,22 @@ class AdaptivePlan {
   void report(nlohmann::json& stats) const;
   const std::vector<PixelMode>& modes() const { return modes_; }
 
+  // The weight of the probes' iterations in the image (ProbeFilm, probe_film.h): the mean over
+  // grid pixels of the relative variance of one rendered iteration (the segments between probes,
+  // as check_last_choice measured them, weighted by their iterations) over that of one probe
+  // (the spread of the probes' own estimates), at most 1: the inverse-variance weight of the
+  // probes against the rest, which minimises the image's summed relative variance for one
+  // global weight. 1 before a segment of at least two iterations was measured. image_means: the
+  // film's pixel means (image size). The variances come from the samples they weight, so the
+  // combination is biased (a ratio estimator, as guided-pt's inverse-variance passes), and
+  // consistent: the probes' share of the iterations vanishes as the render goes on.
+  struct ProbeWeight {
+    double weight = 1;
+    double probe_relative_variance = 0, rendered_relative_variance = 0;  // per iteration
+  };
+  ProbeWeight probe_weight(const std::vector<float>& image_means) const;
+  int probes() const { return probes_; }
+
   struct Candidate {
     float light_path_factor = 0;  // light paths / pixels
     int connections = 0;
@@ -349,8 +365,9 @@ class AdaptivePlan {
                          double thread_seconds, const std::vector<float>& means);
   // Adds what the segment `measured` showed beyond the prediction to unseen_sums_; returns it
   // per grid pixel.
+  // shrunk: the denominators of the segment's relative variances (denominators(means, &measured)).
   double add_unseen(const std::vector<double>& measured, double iterations,
-                    const std::vector<float>& means);
+                    const std::vector<double>& shrunk);
 
   size_t pixels_ = 0;  // the image's
   int width_ = 0, height_ = 0;
@@ -519,6 +536,9 @@ class AdaptivePlan {
   std::vector<double> unseen_variance() const;
   double chosen_cost_ = 0;              // its predicted microseconds per pixel and iteration
   std::vector<nlohmann::json> checks_;  // one per check_last_choice(), for the report
+  // Over the measured segments: their iterations times the mean over grid pixels of one
+  // iteration's relative variance, and those iterations (probe_weight).
+  double rendered_relative_sum_ = 0, rendered_iterations_ = 0;
   std::vector<nlohmann::json> history_;
 };
 

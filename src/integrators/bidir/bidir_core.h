@@ -21,6 +21,7 @@
 #include "integrators/bidir/hash_grid.h"
 #include "integrators/bidir/light_path_assignment.h"
 #include "integrators/bidir/light_vertex.h"
+#include "integrators/bidir/probe_film.h"
 #include "integrators/bidir/segment_moments.h"
 #include "integrators/bidir/technique_images.h"
 #include "integrators/bidir/techniques.h"
@@ -171,10 +172,12 @@ class BidirIntegrator final : public CameraPathIntegrator {
   void report(nlohmann::json& stats) const override;
 
   // guided-bpt / guided-vcm: the passes weighted by the inverse of their variance
-  // (--guiding-combine, as guided-pt; image/inverse_variance.h), else the film's plain average.
+  // (--guiding-combine, as guided-pt; image/inverse_variance.h); adaptive-vcm: its probes
+  // weighted against the other iterations (probe_film.h); else the film's plain average.
   Image image(const Film& film) const override;
-  // guided-bpt / guided-vcm under MPI: the current pass's exact pixel moments, summed over the
-  // ranks (a pass that teaches is rendered whole by every rank: rank 0's is it).
+  // Under MPI: guided-bpt / guided-vcm's current pass, adaptive-vcm's probes, as exact sums
+  // over the ranks (a pass that teaches and every probe are rendered whole by every rank: rank
+  // 0's are the total).
   std::span<FixedSum> sums_over_ranks(bool root) override;
 
   // guided-bpt / guided-vcm: the learned fields (tests).
@@ -387,6 +390,9 @@ class BidirIntegrator final : public CameraPathIntegrator {
   // the ranks that observe_learning_sums() was given for the next probe (empty: read segment_).
   SegmentMoments segment_;
   std::vector<FixedSum> observed_segment_;
+  // The probes' sums beside the film, and the weight image() gave them (probe_film.h).
+  ProbeFilm probe_film_;
+  mutable AdaptivePlan::ProbeWeight probe_weight_;
 };
 
 }  // namespace caustica::bidir

@@ -97,6 +97,8 @@ void BidirIntegrator::prepare(const Scene& scene, Film& film) {
   if (tech_.adaptive && !techniques_.enabled())
     path_tracer_ = std::make_unique<PathTracer>(settings_);
   if (tech_.adaptive) {
+    probe_film_.reset(film.pixel_count());
+    probe_weight_ = {};
     segment_.reset(plan_.grid_image_pixels());
     segment_thread_seconds_ = 0;
     segment_iterations_ = 0;
@@ -151,6 +153,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   std::vector<double> measured;  // the variance the last choice showed, per pixel
   double measured_iterations = 0;
   if (it.plan.probe) {
+    probe_film_.begin_probe(film);
     means_before = observed_ ? std::move(observed_means_) : pixel_means(film);
     measured = SegmentMoments::variances(
         observed_segment_.empty() ? segment_.sums() : observed_segment_, &measured_iterations);
@@ -192,6 +195,7 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   probe_.light_rays = double(light_rays_);
   add_counts(work_total_, probe_);
   if (it.plan.probe) {
+    probe_film_.end_probe(film);  // every estimate of the probe is in the film's totals now
     // The plan prices the recorded pixels' camera-pass work and the whole light pass.
     ProbeWork work = probe_recorded_;
     work.light_paths = probe_.light_paths;
@@ -233,12 +237,20 @@ void BidirIntegrator::finish(const Scene& scene, Film& film) {
 }
 
 Image BidirIntegrator::image(const Film& film) const {
+  if (tech_.adaptive) {
+    probe_weight_ = plan_.probe_weight(pixel_means(film));
+    return probe_film_.image(film, uint32_t(plan_.probes()), probe_weight_.weight);
+  }
   if (!tech_.guided || !settings_.guiding.inverse_variance) return film.image();
   Image combined = guided_passes_.image();
   return combined.empty() ? film.image() : combined;
 }
 
 std::span<FixedSum> BidirIntegrator::sums_over_ranks(bool root) {
+  if (tech_.adaptive) {
+    if (!root) probe_film_.clear();  // every rank holds every probe whole
+    return probe_film_.sums();
+  }
   if (!tech_.guided || !settings_.guiding.inverse_variance) return {};  // the film's image
   if (!root && guiding_.teaches()) guided_passes_.clear_current();
   return guided_passes_.current_sums();
@@ -252,6 +264,11 @@ void BidirIntegrator::report(nlohmann::json& stats) const {
     stats["adaptive"]["probe_seconds"] = probe_seconds_total_;
     stats["adaptive"]["probe_time_fraction"] =
         seconds_total_ > 0 ? probe_seconds_total_ / seconds_total_ : 0.0;
+    // The probes' weight in the image (probe_film.h) and the per-iteration relative variances
+    // it is the ratio of (the last image() computed).
+    stats["adaptive"]["probe_weight"] = probe_weight_.weight;
+    stats["adaptive"]["probe_relative_variance"] = probe_weight_.probe_relative_variance;
+    stats["adaptive"]["rendered_relative_variance"] = probe_weight_.rendered_relative_variance;
   }
   if (tech_.guided) {
     guiding_.report(stats);

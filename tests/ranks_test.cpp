@@ -19,6 +19,14 @@
 namespace caustica {
 namespace {
 
+// How many pixels of two images of one size differ (bit for bit).
+size_t pixels_differing(const Image& a, const Image& b) {
+  size_t n = 0;
+  for (size_t i = 0; i < a.pixel_count(); ++i)
+    if (!(a[i] == b[i])) ++n;
+  return n;
+}
+
 TEST(FixedSum, ConvertsExactlyAboveTheResolutionAndClampsTheRange) {
   for (double v : {0.1, -0.1, 1234.5678, 1.0 / 4096, -3e5})
     EXPECT_EQ(from_fixed(to_fixed(v)), v) << v;
@@ -173,10 +181,7 @@ TEST(RanksRender, TwoRanksIterationsGiveTheOneProcessImageBitForBit) {
     EXPECT_EQ(iterations[0], 3u) << name;  // iterations 0, 2, 4
     EXPECT_EQ(iterations[1], 2u) << name;  // iterations 1, 3
     const Image image = total.image();
-    size_t differing = 0;
-    for (size_t i = 0; i < image.pixel_count(); ++i)
-      if (!(image[i] == single.image[i])) ++differing;
-    EXPECT_EQ(differing, 0u) << name;
+    EXPECT_EQ(pixels_differing(image, single.image), 0u) << name;
   }
 }
 
@@ -329,17 +334,11 @@ TEST(RanksRender, AdaptiveVcmOnTwoRanksGivesTheOneProcessImageBitForBit) {
   // ... and of the pixel moments of the iterations between probes, whose measured variance
   // the report sets against the prediction for the choice.
   EXPECT_EQ(pair.learning_sums, probes);
-  size_t differing = 0;
-  for (size_t i = 0; i < pair.image.pixel_count(); ++i)
-    if (!(pair.image[i] == single.image[i])) ++differing;
-  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(pixels_differing(pair.image, single.image), 0u);
   // A different seed changes the image, or the comparison proves nothing.
   settings.seed = 8;
   const RenderResult other = test::render_with(*scene, "adaptive-vcm", spp, settings);
-  differing = 0;
-  for (size_t i = 0; i < other.image.pixel_count(); ++i)
-    if (!(other.image[i] == single.image[i])) ++differing;
-  EXPECT_GT(differing, 0u);
+  EXPECT_GT(pixels_differing(other.image, single.image), 0u);
 }
 
 // The same with probes of one pixel in each 2 x 2 block (the stride of images of more than
@@ -352,16 +351,10 @@ TEST(RanksRender, AdaptiveVcmWithSparseProbesOnTwoRanksGivesTheOneProcessImage) 
   const int spp = 12;
   const RenderResult single = test::render_with(*scene, "adaptive-vcm", spp, settings);
   const PairResult pair = render_on_thread_pair(*scene, "adaptive-vcm", settings, spp);
-  size_t differing = 0;
-  for (size_t i = 0; i < pair.image.pixel_count(); ++i)
-    if (!(pair.image[i] == single.image[i])) ++differing;
-  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(pixels_differing(pair.image, single.image), 0u);
   settings.bidir.probe_stride = 1;  // and the stride changes the image
   const RenderResult dense = test::render_with(*scene, "adaptive-vcm", spp, settings);
-  differing = 0;
-  for (size_t i = 0; i < dense.image.pixel_count(); ++i)
-    if (!(dense.image[i] == single.image[i])) ++differing;
-  EXPECT_GT(differing, 0u);
+  EXPECT_GT(pixels_differing(dense.image, single.image), 0u);
 }
 
 // The probes weighted against the other iterations in the image (probe_film.h): every rank
@@ -379,10 +372,7 @@ TEST(RanksRender, AdaptiveVcmWithWeightedProbesOnTwoRanksGivesTheOneProcessImage
   EXPECT_GT(weight, 0.0);
   const RenderResult single = test::render_with(*scene, "adaptive-vcm", spp, settings);
   const PairResult pair = render_on_thread_pair(*scene, "adaptive-vcm", settings, spp);
-  size_t differing = 0;
-  for (size_t i = 0; i < pair.image.pixel_count(); ++i)
-    if (!(pair.image[i] == single.image[i])) ++differing;
-  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(pixels_differing(pair.image, single.image), 0u);
 }
 
 // The guided integrators' training passes are shared: every rank renders them, so every rank
@@ -404,16 +394,10 @@ TEST(RanksRender, GuidedIntegratorsOnTwoRanksGiveTheOneProcessImageBitForBit) {
     EXPECT_EQ(pair.iterations[1], 10u) << name;
     EXPECT_EQ(pair.meetings, 8) << name << ": one meeting before each training iteration";
     EXPECT_EQ(pair.sums, 0) << name << ": the films are not summed before them";
-    size_t differing = 0;
-    for (size_t i = 0; i < pair.image.pixel_count(); ++i)
-      if (!(pair.image[i] == single.image[i])) ++differing;
-    EXPECT_EQ(differing, 0u) << name;
+    EXPECT_EQ(pixels_differing(pair.image, single.image), 0u) << name;
     settings.seed = 8;  // a different seed changes the image, or the comparison proves nothing
     const RenderResult other = test::render_with(*scene, name, spp, settings);
-    differing = 0;
-    for (size_t i = 0; i < other.image.pixel_count(); ++i)
-      if (!(other.image[i] == single.image[i])) ++differing;
-    EXPECT_GT(differing, 0u) << name;
+    EXPECT_GT(pixels_differing(other.image, single.image), 0u) << name;
   }
 }
 

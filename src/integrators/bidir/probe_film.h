@@ -16,6 +16,7 @@
 // others'). Memory: 48 bytes per pixel.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>

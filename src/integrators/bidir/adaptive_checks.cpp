@@ -117,12 +117,8 @@ AdaptivePlan::ProbeWeight AdaptivePlan::probe_weight(const std::vector<float>& i
   if (probes_ < 2 || !(rendered_iterations_ > 0)) return w;
   const std::vector<float> means = on_grid(image_means);
   if (means.size() != grid_pixels_) return w;
-  // One probe's variance per pixel: the unbiased spread of the probes' estimates.
-  const double k = double(probes_);
   std::vector<double> own(grid_pixels_);
-  for (size_t p = 0; p < grid_pixels_; ++p)
-    own[p] = std::max(
-        (estimate_square_sums_[p] - estimate_sums_[p] * estimate_sums_[p] / k) / (k - 1), 0.0);
+  for (size_t p = 0; p < grid_pixels_; ++p) own[p] = std::max(probe_estimate_variance(p), 0.0);
   w.probe_relative_variance = finite_mean(own, denominators(means));
   w.rendered_relative_variance = rendered_relative_sum_ / rendered_iterations_;
   if (w.probe_relative_variance > 0 && std::isfinite(w.rendered_relative_variance))

@@ -278,8 +278,7 @@ std::vector<double> AdaptivePlan::denominators(const std::vector<float>& means,
   const std::vector<double> m(means.begin(), means.end());
   const std::vector<double> pooled = box_blur(m, grid_w_, grid_h_, kPoolRadius);
   std::vector<double> own(grid_pixels_);
-  for (size_t p = 0; p < grid_pixels_; ++p)
-    own[p] = (estimate_square_sums_[p] - estimate_sums_[p] * estimate_sums_[p] / k) / (k - 1);
+  for (size_t p = 0; p < grid_pixels_; ++p) own[p] = probe_estimate_variance(p);
   const std::vector<double> pooled_variance = box_blur(own, grid_w_, grid_h_, kPoolRadius);
   for (size_t p = 0; p < grid_pixels_; ++p) {
     // kShrinkSigmas^2 times the film mean's variance, from the larger of the pixel's own and

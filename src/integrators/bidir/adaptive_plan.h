@@ -472,6 +472,12 @@ class AdaptivePlan {
   std::vector<double> denominator_;
   // mean^2 for pixel p whose film mean is m: mean_square_sums_ / mean_square_probes_, or m^2.
   double mean_square(size_t p, double m) const;
+  // The variance of one probe's estimate of grid pixel p, from the spread of the probes' own
+  // estimates (unbiased; it may come out negative by rounding). Needs two probes.
+  double probe_estimate_variance(size_t p) const {
+    const double k = double(probes_);
+    return (estimate_square_sums_[p] - estimate_sums_[p] * estimate_sums_[p] / k) / (k - 1);
+  }
   // Per grid pixel, pooled as the variances are: what path tracing's bias adds to its variance
   // per iteration, the relative bias^2 times the weight that turns it into a per-iteration
   // variance, the iterations path tracing would render in the budget

@@ -298,9 +298,9 @@ TEST(PbrtSharedScenes, CornellCausticsLoadsAndProjectsLikePbrtV4) {
 }
 
 TEST(PbrtSharedScenes, EveryOwnSceneLoads) {
-  for (const char* name :
-       {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic", "mis-plates",
-        "point-room", "sun-glass", "spot-glass", "sky-spheres", "corner", "lamp"}) {
+  for (const char* name : {"cornell-caustics", "door-ajar", "material-spheres", "mirror-caustic",
+                           "mis-plates", "point-room", "sun-glass", "spot-glass", "sky-spheres",
+                           "corner", "lamp", "window", "bulb"}) {
     SCOPED_TRACE(name);
     test::captured_warnings().clear();
     std::unique_ptr<Scene> scene;

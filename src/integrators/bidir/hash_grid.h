@@ -1,8 +1,9 @@
 // Range search over the stored light vertices: a hashed uniform grid with cells of size 2r,
 // built by a counting sort in vertex order (deterministic, no per-cell allocation). A query
 // visits the 2x2x2 cells that a ball of radius r around the point can touch (Georgiev's
-// SmallVCM grid, Teschner et al. 2003 hash). Two of those cells can hash to one bucket; each
-// bucket is visited once, so no vertex is ever counted twice.
+// SmallVCM grid, Teschner et al. 2003 hash, here of blocks of 2x2x2 cells: see hash()). Two of
+// those cells can hash to one bucket; each bucket is visited once, so no vertex is ever counted
+// twice.
 //
 // Speed (profiled on cornell-glass, vcm 512x512): a query scans whole buckets of which only a
 // few vertices lie within r, so the scan is the cost. The positions are therefore kept a second
@@ -25,7 +26,7 @@ namespace caustica::bidir {
 
 class HashGrid {
  public:
-  // table_size: buckets (rounded up to a power of two); 0 = about the vertex count.
+  // table_size: buckets (rounded up to a power of two); 0 = about a quarter of the vertex count.
   void build(const std::vector<LightVertex>& vertices, float radius, uint32_t table_size = 0);
 
   // fn(vertex_index, light_position) for every vertex within the radius of p.
@@ -100,9 +101,15 @@ class HashGrid {
     return hash(int(std::floor(grid_coordinate(p, 0))), int(std::floor(grid_coordinate(p, 1))),
                 int(std::floor(grid_coordinate(p, 2))));
   }
+  // Cells are hashed in blocks of 2x2x2 (Teschner et al.'s hash of the block), the eight cells of
+  // a block in consecutive buckets: a query's 2x2x2 cells lie in 3.4 blocks on average instead
+  // of 8 scattered buckets, so fewer of its table lookups and entry scans miss the cache, and
+  // neighbouring queries share them.
   uint32_t hash(int x, int y, int z) const {
-    return ((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ (uint32_t(z) * 83492791u)) &
-           (table_size_ - 1);
+    const uint32_t block = (uint32_t(x >> 1) * 73856093u) ^ (uint32_t(y >> 1) * 19349663u) ^
+                           (uint32_t(z >> 1) * 83492791u);
+    const uint32_t cell = uint32_t(x & 1) | uint32_t(y & 1) << 1 | uint32_t(z & 1) << 2;
+    return (block * 8u + cell) & (table_size_ - 1);
   }
 
   Vec3 lo_;

@@ -180,7 +180,7 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
                                      bool merge, bool power, double light_paths, double radius,
                                      ScratchArena& arena, double raster_density = 1,
                                      double connections = 1, const BidirGuiding* guiding = nullptr,
-                                     double merge_scale = 1) {
+                                     double merge_scale = 1, bool correlation_aware = false) {
   const Light& light = *path.light;
   const bool finite = !light.is_infinite();
   const double pmf = scene.light_sampler().pmf(&light);
@@ -265,10 +265,28 @@ std::map<Key, double> oracle_weights(const Scene& scene, const ExplicitPath& pat
   if (connect && (k == 1 ? light.type() == LightType::Area : !delta(k - 1)))
     p[{false, k, 1}] = (k == 1 ? 1.0 : q(GuidingField::kLensConnection, k - 1, dir(k - 1, k))) *
                        light_paths * prod(light_pdf, 0, k - 1);
+  // Correlation-aware MIS (Grittmann et al. 2021): the merge at x_j counts c_j times, from the
+  // acceptances min(1, A p) of the area densities with which each side samples each vertex (1
+  // where a delta lobe samples it, and for a delta or infinite light's position).
+  std::vector<double> correlation(k, 1.0);
+  if (correlation_aware) {
+    const double area = kPi * radius * radius;
+    auto accept = [&](double p) { return std::min(1.0, area * p); };
+    std::vector<double> a_light(k), a_camera(k);
+    a_light[0] = finite && !light.is_delta() ? accept(light_pdf[0]) : 1.0;
+    for (int i = 1; i < k; ++i) a_light[i] = i >= 2 && delta(i - 1) ? 1.0 : accept(light_pdf[i]);
+    for (int i = 0; i < k; ++i)
+      a_camera[i] = i + 1 <= k - 1 && delta(i + 1) ? 1.0 : accept(camera_pdf[i]);
+    for (int j = 1; j < k; ++j) {
+      const double cam = prod(a_camera, j, k - 1), lit = prod(a_light, 0, j);
+      const double denominator = cam + lit - cam * lit;
+      correlation[j] = denominator > 0 ? std::max(cam / denominator, 1.0 / light_paths) : 1.0;
+    }
+  }
   for (int j = 1; merge && j <= k - 1; ++j)
     if (!delta(j))
-      p[{true, j + 1, k + 1 - j}] = merge_scale * light_paths * kPi * radius * radius *
-                                    prod(light_pdf, 0, j) * prod(camera_pdf, j, k - 1);
+      p[{true, j + 1, k + 1 - j}] = correlation[j] * merge_scale * light_paths * kPi * radius *
+                                    radius * prod(light_pdf, 0, j) * prod(camera_pdf, j, k - 1);
   double total = 0;
   for (auto& [key, v] : p) {
     v = power ? v * v : v;
@@ -288,6 +306,8 @@ struct Case {
   bool guided = false;       // guided-bpt / guided-vcm: densities of trained guiding fields
   bool guide_camera = true, guide_light = true;  // which subpaths (--guiding-subpaths)
   float merge_scale = 1;                         // --merge-mis-scale
+  bool correlation_aware = false;                // --merge-mis correlation-aware
+  float radius = 0.02f;
 };
 
 // Fields of guided-bpt / guided-vcm trained on synthetic records: surface points hit by rays from
@@ -355,27 +375,35 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
   const std::unique_ptr<BidirGuiding> guiding =
       c.guided ? trained_guiding(scene, c.guide_camera, c.guide_light) : nullptr;
   int guided_vertices = 0, reduced_vertices = 0;
-  const float light_paths = c.light_paths, radius = 0.02f;
+  const float light_paths = c.light_paths, radius = c.radius;
   const bool connect = c.algorithm != BidirAlgorithm::Bpm,
              merge = c.algorithm != BidirAlgorithm::Bpt &&
                      c.algorithm != BidirAlgorithm::GuidedBpt && c.pixel_merges;
   int checked = 0, attempts = 0, with_delta = 0, seen_directly = 0;
   double worst_sum = 0, worst_oracle = 0;
-  int stop_compared = 0;  // techniques whose photon-mapping density was compared
+  int stop_compared = 0;            // techniques whose photon-mapping density was compared
+  double moved_by_correlation = 0;  // the largest change of a weight by correlation-aware MIS
   ExplicitPath path;
   while (checked < paths && attempts < 50 * paths) {
     ++attempts;
     arena.reset();
     if (!random_path(scene, rng, arena, &path)) continue;
     const float density = filter_densities ? 0.01f + 3.99f * rng.next_float() : 1.f;
-    const auto weights =
-        production_weights(scene, c.algorithm, c.heuristic, light_paths, radius, path, arena,
-                           density, c.connections, c.pixel_merges, guiding.get(), c.merge_scale);
-    const auto oracle =
-        oracle_weights(scene, path, connect, merge, c.heuristic == MisHeuristic::Power, light_paths,
-                       radius, arena, density, c.connections, guiding.get(), c.merge_scale);
+    const auto weights = production_weights(scene, c.algorithm, c.heuristic, light_paths, radius,
+                                            path, arena, density, c.connections, c.pixel_merges,
+                                            guiding.get(), c.merge_scale, c.correlation_aware);
+    const auto oracle = oracle_weights(
+        scene, path, connect, merge, c.heuristic == MisHeuristic::Power, light_paths, radius, arena,
+        density, c.connections, guiding.get(), c.merge_scale, c.correlation_aware);
     if (oracle.empty() || !std::isfinite(oracle.begin()->second))
-      continue;  // no technique can make it
+      continue;                 // no technique can make it
+    if (c.correlation_aware) {  // the correlation must matter, or the case proves nothing
+      const auto balance = oracle_weights(
+          scene, path, connect, merge, c.heuristic == MisHeuristic::Power, light_paths, radius,
+          arena, density, c.connections, guiding.get(), c.merge_scale, false);
+      for (const auto& [key, w] : oracle)
+        moved_by_correlation = std::max(moved_by_correlation, std::abs(w - balance.at(key)));
+    }
     double sum = 0;
     for (const auto& w : weights) {
       sum += w.weight;
@@ -451,10 +479,16 @@ void check_partition_of_unity(const Scene& scene, const Case& c, int paths,
     // ... and learned technique probabilities below 1: on average one vertex in four paths.
     EXPECT_GT(4 * reduced_vertices, paths) << c.scene;
   }
+  if (c.correlation_aware) {
+    EXPECT_GT(moved_by_correlation, 0.02) << c.scene;
+  }
   std::printf(
       "[ partition ] %-14s %d paths (%d through delta vertices, %d lights seen directly), max "
-      "|sum - 1| = %.2e, max |w - oracle| = %.2e\n",
-      c.scene, checked, with_delta, seen_directly, worst_sum, worst_oracle);
+      "|sum - 1| = %.2e, max |w - oracle| = %.2e%s\n",
+      c.scene, checked, with_delta, seen_directly, worst_sum, worst_oracle,
+      c.correlation_aware
+          ? (", correlation moved a weight by " + std::to_string(moved_by_correlation)).c_str()
+          : "");
 }
 
 std::unique_ptr<Scene> scene_named(const std::string& name) {
@@ -508,7 +542,19 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Power, 700, 2, true, false, true, true,
              4.f},
         Case{"cornell", BidirAlgorithm::GuidedVcm, MisHeuristic::Balance, 1024, 1, true, true, true,
-             true, 0.5f}),
+             true, 0.5f},
+        // --merge-mis correlation-aware: each merge's count times c_j (renderer and oracle),
+        // with radii whose acceptances lie well below 1, around it, and at 1 for the first hits.
+        Case{"cornell", BidirAlgorithm::Vcm, MisHeuristic::Balance, 1024, 1, true, false, true,
+             true, 1.f, true},
+        Case{"cornell-glass", BidirAlgorithm::Vcm, MisHeuristic::Power, 1024, 1, true, false, true,
+             true, 1.f, true, 0.2f},
+        Case{"mixed-lights", BidirAlgorithm::Vcm, MisHeuristic::Balance, 1024, 1, true, false, true,
+             true, 1.f, true, 0.1f},
+        Case{"env-furnace", BidirAlgorithm::Vcm, MisHeuristic::Balance, 1024, 1, true, false, true,
+             true, 1.f, true, 0.5f},
+        Case{"corners", BidirAlgorithm::Vcm, MisHeuristic::Balance, 700, 1, true, false, true, true,
+             1.f, true, 0.05f}),
     [](const auto& info) {
       std::string n =
           std::string(info.param.scene) + "_" + std::to_string(int(info.param.algorithm)) + "_" +
@@ -519,7 +565,10 @@ INSTANTIATE_TEST_SUITE_P(
           (info.param.guide_camera ? "" : "_light") +
           (info.param.merge_scale == 1
                ? ""
-               : "_mergescale" + std::to_string(int(100 * info.param.merge_scale)));
+               : "_mergescale" + std::to_string(int(100 * info.param.merge_scale))) +
+          (info.param.correlation_aware
+               ? "_correlated_r" + std::to_string(int(1000 * info.param.radius))
+               : "");
       for (char& ch : n)
         if (ch == '-') ch = '_';
       return n;

@@ -65,6 +65,28 @@ TEST(Cli, MalformedSceneFileGivesOneLocatedErrorAndNoImage) {
   EXPECT_TRUE(only_stderr_file(d));
 }
 
+// --merge-mis correlation-aware keeps each subpath's merges one by one, at most 128: a deeper
+// render is refused before anything is loaded into a film, and the option's values are checked.
+TEST(Cli, CorrelationAwareMisRefusesDepthsItCannotHoldAndUnknownValues) {
+  const fs::path d = fresh_dir("merge_mis");
+  CliRun r =
+      run("render cornell --integrator vcm --merge-mis correlation-aware --max-depth 129 "
+          "--spp 1 --outfile out",
+          d);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("at most 128"), std::string::npos) << r.err;
+  EXPECT_TRUE(only_stderr_file(d)) << "no output for bad input";
+  r = run("render cornell --integrator vcm --merge-mis power --spp 1 --outfile out", d);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("correlation-aware"), std::string::npos) << r.err;
+  r =
+      run("render cornell --integrator vcm --merge-mis correlation-aware --max-depth 6 --spp 1 "
+          "--resolution 16x16 --outfile out",
+          d);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(d / "out.exr"));
+}
+
 TEST(Cli, MissingFileIsAnErrorNamingIt) {
   const fs::path d = fresh_dir("missing");
   const CliRun r = run("render nothere.pbrt --spp 1", d);

@@ -3,7 +3,9 @@
 #include <chrono>
 #include <cstdint>
 #include <limits>
+#include <string>
 
+#include "integrators/bidir/mis.h"
 #include "io/scene_loader.h"
 #include "preflight.h"
 
@@ -97,6 +99,10 @@ CLI::Option* add_shared_options(CheckedOptions& o, SharedOptions* s, const std::
            "vcm / guided-vcm: factor of the merges' sample count N pi r^2 in the MIS weights "
            "only, in (0, 100] (default 1: the balance heuristic of Georgiev et al. 2012; below 1 "
            "trusts merging less; the weights still sum to one; adaptive-vcm keeps 1)");
+  o.choice("--merge-mis", &s->merge_mis, {"balance", "correlation-aware"},
+           "vcm: the merges' MIS weights: the balance heuristic's count N pi r^2 (default), or "
+           "that count lowered per merge by the correlation of the paths that share its light "
+           "subpath (Grittmann et al. 2021; --max-depth at most 128)");
   o.choice("--adaptive-costs", &s->adaptive_costs, {"model", "measured"},
            "adaptive-vcm: price techniques with the fixed cost model (default; deterministic) or "
            "with costs measured on this machine while rendering (not reproducible)");
@@ -149,6 +155,14 @@ int load_configured_scene(const SceneSetup& s, std::unique_ptr<Scene>* scene,
     settings->mis = s.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
   settings->bidir = s.bidir;
   settings->bidir.measured_costs = s.adaptive_costs == "measured";
+  settings->bidir.correlation_aware = s.merge_mis == "correlation-aware";
+  if (settings->bidir.correlation_aware &&
+      settings->max_depth > bidir::CorrelationTrack::kMaxEntries) {
+    print_error("--merge-mis correlation-aware supports a maximum depth of at most " +
+                std::to_string(bidir::CorrelationTrack::kMaxEntries) + ", not " +
+                std::to_string(settings->max_depth) + " (give --max-depth)");
+    return 2;
+  }
   settings->guiding = s.guiding;
   settings->guiding.max_bytes = size_t(s.guiding_max_mb) << 20;
   settings->guiding.filter = s.guiding_filter == "on";

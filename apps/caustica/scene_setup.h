@@ -24,6 +24,7 @@ struct SceneSetup {
   // ignore it).
   BidirSettings bidir;  // --light-paths, --radius, --radius-alpha, --techniques, --connections
   std::string adaptive_costs;  // --adaptive-costs: "", "model" or "measured"
+  std::string merge_mis;       // --merge-mis: "", "balance" or "correlation-aware"
   // --guiding-spatial-threshold, --guiding-rho, --guiding-bsdf-fraction, --guiding-nee-floor;
   // the others below.
   GuidingSettings guiding;

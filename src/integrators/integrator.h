@@ -34,6 +34,10 @@ struct BidirSettings {
   // (Grittmann et al. 2021) moves per vertex: merges share their light subpaths, so they are
   // worth fewer than N independent samples. (bpm: every technique merges, the factor cancels.)
   float merge_mis_scale = 1;
+  // vcm: correlation-aware MIS for the merges (Grittmann, Georgiev and Slusallek 2021;
+  // bidir/mis.h, CorrelationTrack): each merge's count is lowered by how much of its path the
+  // merges around it share. --merge-mis correlation-aware.
+  bool correlation_aware = false;
   // adaptive-vcm: price techniques with costs measured on this machine while rendering
   // (non-deterministic) instead of the fixed cost model.
   bool measured_costs = false;

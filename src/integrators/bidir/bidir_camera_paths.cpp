@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "integrators/bidir/bidir_core.h"
 #include "integrators/bidir/subpath_records.h"
@@ -86,6 +87,15 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   if (!(pdf_camera > 0)) return;
   const MisRules& rules = *acc.rules;
   MisSums mis = rules.camera_start(pdf_camera);
+  // Correlation-aware MIS: the subpath's merges one by one, for `mis` and for the sums at the
+  // current hit (mis.h, CorrelationTrack).
+  std::optional<CorrelationTrack> track, track_at_hit;
+  if (rules.correlated()) {
+    track.emplace();
+    track_at_hit.emplace();
+    rules.correlation_camera_start(*track, pdf_camera);
+    mis.corr = &*track;
+  }
   const int max_depth = settings_.max_depth;
   const uint64_t light_path = it.light_path_of.light_path(pixel);
 
@@ -140,6 +150,10 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     Bsdf bsdf;
     if (si.material) bsdf = si.material->bsdf(si, arena);
     MisSums at_hit = mis;
+    if (track) {
+      track_at_hit->assign(*track);
+      at_hit.corr = &*track_at_hit;
+    }
     rules.hit(at_hit, segment * segment, geometric_cos(si, si.wo));
 
     for_each_emitter_seen(scene.infinite_lights(), ray, &si, [&](const Light& l, Rgb Le) {
@@ -153,6 +167,10 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     }
     ++depth;
     mis = at_hit;
+    if (track) {
+      track->assign(*track_at_hit);
+      mis.corr = &*track;
+    }
     segment = 0;
     if (depth > max_depth) break;
 
@@ -293,6 +311,8 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
     std::uninitialized_default_construct_n(acc.own_path, end - first);
   }
   RebuiltLightVertex scratch;  // a vertex of another light path, rebuilt for this connection
+  std::optional<CorrelationTrack> light_track;  // correlation-aware MIS
+  if (rules.correlated()) light_track.emplace();
   for (uint32_t i = first; i < end; ++i) {
     const LightVertex& stored = vertices_[i];
     // Stored in increasing depth: once too long, all the rest are too.
@@ -339,7 +359,12 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
       guiding_.count_technique(GuidingField::kConnection, probabilities.leaf_toward(-dir),
                                !occluded);
     if (occluded) continue;
-    TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, v.mis, si, bsdf,
+    MisSums light_mis = v.mis;
+    if (light_track) {
+      load_track(i, &*light_track);
+      light_mis.corr = &*light_track;
+    }
+    TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, light_mis, si, bsdf,
                                             cv.mis, rebuilt.guides, cv.guides);
     terms.own_factor = rules.mis(q);
     const float w = terms.weight(rules.counts());
@@ -362,6 +387,8 @@ void BidirIntegrator::merge(const Scene& scene, const Iteration& it, const MisRu
   const int max_depth = settings_.max_depth;
   const Scene::PrimitiveRange own_shape = scene.shape_primitives(si);
   const float max_off_plane = 0.5f * it.radius;
+  std::optional<CorrelationTrack> light_track;  // correlation-aware MIS
+  if (rules.correlated()) light_track.emplace();
   grid_.for_each_near(si.p, vertices_, [&](uint32_t index, Vec3 q) {
     ++acc.work.photons;
     acc.work.stop_photons += stop_query;
@@ -369,7 +396,7 @@ void BidirIntegrator::merge(const Scene& scene, const Iteration& it, const MisRu
     const int light_depth = light_vertex_depth(stored);
     if (light_depth + depth - 1 > max_depth) return;
     if (std::abs(dot(q - si.p, si.ng)) > max_off_plane) return;
-    const LightVertexData v = unpack_light_vertex(stored);
+    LightVertexData v = unpack_light_vertex(stored);
     // The photon's throughput carries the flux through the surface (geometric cosine); the
     // camera vertex integrates with the shading cosine: |ns . wi| / |ng . wi|, as NEE and
     // connections have it through abs_cos (Veach 1997, section 5.3).
@@ -385,6 +412,10 @@ void BidirIntegrator::merge(const Scene& scene, const Iteration& it, const MisRu
       acc.add(true, light_depth + 1, depth + 1,
               cv.beta * f * v.throughput * it.merge_normalization);
       return;
+    }
+    if (light_track) {
+      load_track(index, &*light_track);
+      v.mis.corr = &*light_track;
     }
     const TechniqueTerms terms = terms_merge(rules, v.wo, v.mis, si, bsdf, cv.mis, cv.guides);
     const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());

@@ -62,10 +62,19 @@ struct Splat {
 // Scalar of a contribution for the adaptive plan's moments.
 inline float scalar(Rgb v) { return (v.r + v.g + v.b) * (1.f / 3.f); }
 
+// A stored light vertex's CorrelationTrack (correlation-aware MIS): its entries in a pool.
+struct StoredTrack {
+  uint32_t first = 0, count = 0;  // entries in the pool
+  float own_total = 1, seg_cos = 0, seg_dist2 = 1;
+};
+
 // What one chunk of light paths leaves behind.
 struct LightChunk {
   uint64_t first_path = 0;
   std::vector<LightVertex> vertices;
+  // Correlation-aware MIS: per vertex its track, the entries in one pool (first: in the pool).
+  std::vector<StoredTrack> tracks;
+  std::vector<CorrelationEntry> track_entries;
   std::vector<uint32_t> path_ends;  // per path: vertices.size() after it
   std::vector<Splat> splats;
   // Probes: the MIS terms of the splats that land in recorded pixels, in splat order.
@@ -205,6 +214,15 @@ class BidirIntegrator final : public CameraPathIntegrator {
 
  private:
   bool stores_vertices() const { return tech_.connect || tech_.merge; }
+  // --merge-mis correlation-aware, which only vcm takes.
+  // (The command line refuses a --max-depth beyond what a CorrelationTrack holds; other callers
+  // get the balance heuristic there.)
+  bool correlation_aware() const {
+    return settings_.bidir.correlation_aware && algorithm_ == BidirAlgorithm::Vcm &&
+           settings_.max_depth <= CorrelationTrack::kMaxEntries;
+  }
+  // The track stored with light vertex `index` (correlation-aware MIS).
+  void load_track(uint32_t index, CorrelationTrack* out) const;
 
   // Scalar pixel means of the film's completed iterations (empty before the first); between
   // iterations only (film.h).
@@ -340,6 +358,8 @@ class BidirIntegrator final : public CameraPathIntegrator {
   std::vector<LightChunk> chunk_buffers_;  // one per chunk in flight (trace_light_paths)
   double light_chunk_seconds_ = 0;         // probe iterations: the chunks' tracing times, summed
   std::vector<LightVertex> vertices_;
+  std::vector<StoredTrack> tracks_;              // per vertex (correlation-aware MIS)
+  std::vector<CorrelationEntry> track_entries_;  // their entries
   std::vector<uint32_t> path_begin_;
   HashGrid grid_;
   Image splat_image_;

@@ -130,6 +130,9 @@ void BidirIntegrator::render_iteration(const Scene& scene, uint32_t iteration, F
   const float merge_scale = tech_.adaptive ? 1.f : settings_.bidir.merge_mis_scale;
   counts.merge = tech_.merge ? kPi * it.radius * it.radius * float(n) * merge_scale : 0.f;
   it.rules = MisRules(heuristic_, counts);
+  // --merge-mis correlation-aware: vcm only (the others keep the balance heuristic's counts).
+  if (correlation_aware() && n > 0)
+    it.rules.enable_correlation(kPi * it.radius * it.radius, 1.f / float(n));
   it.rules_no_merge = it.rules.with_merging(false);
   it.rules_camera_only = MisRules(heuristic_, {counts.emitter, 0.f, 0.f, 0.f});
   it.rules_probe = it.rules;

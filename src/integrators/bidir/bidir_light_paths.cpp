@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <optional>
 
 #include "film/film.h"
 #include "integrators/bidir/bidir_core.h"
@@ -36,6 +37,8 @@ Ray ray_leaving_light(const LightLeSample& le, const Light& light) {
 void BidirIntegrator::trace_light_paths(const Scene& scene, const Iteration& it, Film& film) {
   const auto start = std::chrono::steady_clock::now();
   vertices_.clear();
+  tracks_.clear();
+  track_entries_.clear();
   path_begin_.resize(it.plan.light_paths + 1);
   light_chunk_seconds_ = 0;
   light_rays_ = 0;
@@ -89,6 +92,8 @@ void BidirIntegrator::trace_chunk(const Scene& scene, const Iteration& it, uint6
                                   LightChunk& chunk) const {
   thread_local ScratchArena arena;
   chunk.vertices.clear();
+  chunk.tracks.clear();
+  chunk.track_entries.clear();
   chunk.path_ends.clear();
   chunk.splats.clear();
   chunk.splat_terms.clear();
@@ -116,6 +121,15 @@ void BidirIntegrator::append_chunk(const Iteration& it, const LightChunk& chunk)
   }
   const uint32_t base = uint32_t(vertices_.size());
   vertices_.insert(vertices_.end(), chunk.vertices.begin(), chunk.vertices.end());
+  if (!chunk.tracks.empty()) {
+    const uint32_t entries_base = uint32_t(track_entries_.size());
+    for (StoredTrack t : chunk.tracks) {
+      t.first += entries_base;
+      tracks_.push_back(t);
+    }
+    track_entries_.insert(track_entries_.end(), chunk.track_entries.begin(),
+                          chunk.track_entries.end());
+  }
   for (size_t i = 0; i < chunk.path_ends.size(); ++i)
     path_begin_[chunk.first_path + i] = base + (i ? chunk.path_ends[i - 1] : 0);
   light_chunk_seconds_ += chunk.seconds;
@@ -128,6 +142,15 @@ void BidirIntegrator::append_chunk(const Iteration& it, const LightChunk& chunk)
       plan_.add_light_trace(s.pixel, scalar(s.value), &chunk.splat_terms[recorded++],
                             it.rules_probe.counts());
   }
+}
+
+void BidirIntegrator::load_track(uint32_t index, CorrelationTrack* out) const {
+  const StoredTrack& t = tracks_[index];
+  out->count = int(t.count);
+  std::copy_n(track_entries_.begin() + t.first, t.count, out->entries.begin());
+  out->own_total = t.own_total;
+  out->seg_cos = t.seg_cos;
+  out->seg_dist2 = t.seg_dist2;
 }
 
 void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, uint64_t path,
@@ -157,6 +180,9 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
     importance_records.emplace(arena, max_depth);
   Rgb seen(0.f);  // the unweighted lens connections so far
   MisSums mis;
+  // Correlation-aware MIS: the subpath's merges one by one (mis.corr points here).
+  std::optional<CorrelationTrack> track;
+  if (it.rules.correlated()) track.emplace();
   float segment = 0;  // distance since the previous real vertex (interfaces are skipped)
   int depth = 0;
   for (;;) {
@@ -172,7 +198,7 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
     }
     ++depth;
     if (depth == 1) {
-      mis = light_subpath_start(it.rules, *light, pmf, *le, si, segment);
+      mis = light_subpath_start(it.rules, *light, pmf, *le, si, segment, track ? &*track : nullptr);
     } else {
       it.rules.hit(mis, segment * segment, geometric_cos(si, si.wo));
     }
@@ -190,6 +216,12 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
       if (stores_vertices()) {
         chunk.vertices.push_back(
             pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}));
+        if (track) {
+          chunk.tracks.push_back({uint32_t(chunk.track_entries.size()), uint32_t(track->count),
+                                  track->own_total, track->seg_cos, track->seg_dist2});
+          chunk.track_entries.insert(chunk.track_entries.end(), track->entries.begin(),
+                                     track->entries.begin() + track->count);
+        }
       }
       if (tech_.light_to_camera) {
         const Rgb c = connect_to_camera(scene, it, si, bsdf, guided_mis() ? guides : kUnguided,

@@ -1,5 +1,7 @@
 #include "integrators/bidir/mis.h"
 
+#include <algorithm>
+
 #include "core/math.h"
 
 namespace caustica::bidir {
@@ -110,6 +112,12 @@ void MisRules::hit(MisSums& s, float dist2, float cos_at_hit) const {
   s.conn = times(s.conn, inv_cos);
   s.merge = times(s.merge, inv_cos);
   s.first_merge = times(s.first_merge, inv_cos);
+  if (s.corr && correlated()) {
+    CorrelationTrack& t = *s.corr;
+    for (int i = 0; i < t.count; ++i) t.entries[i].term = times(t.entries[i].term, inv_cos);
+    if (!t.next_specular) t.own_total *= acceptance(t.next_pdf * cos_at_hit / dist2);
+    t.seg_dist2 = dist2;
+  }
 }
 
 void MisRules::scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev,
@@ -125,6 +133,13 @@ void MisRules::scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev,
     s.conn = times(s.conn, c);
     s.merge = times(s.merge, c);
     s.first_merge = times(s.first_merge, c);
+    if (s.corr && correlated()) {
+      // The vertex before is sampled from this one through a delta lobe: acceptance 1.
+      CorrelationTrack& t = *s.corr;
+      for (int i = 0; i < t.count; ++i) t.entries[i].term = times(t.entries[i].term, c);
+      t.next_specular = true;
+      t.seg_cos = cos_out;
+    }
     return;
   }
   // eqs. 34-36 (the 1/dist^2 and 1/cos of the next vertex follow in hit()). The vertex's own
@@ -139,10 +154,77 @@ void MisRules::scatter(MisSums& s, float cos_out, float pdf_fwd, float pdf_rev,
   s.first_merge = s.past_delta_chain ? times(g, times(s.first_merge, rev)) : g;
   s.past_delta_chain = true;
   s.vcm = mis(1.f / pdf_fwd);
+  if (s.corr && correlated()) {
+    // As merge: the merges behind gain g x rev and the vertex before this one its reverse
+    // acceptance; the merge here joins with g.
+    CorrelationTrack& t = *s.corr;
+    const float a_prev = reverse_acceptance(t, pdf_rev);
+    for (int i = 0; i < t.count; ++i) {
+      CorrelationEntry& e = t.entries[i];
+      e.term = times(g, times(e.term, rev));
+      e.rev *= a_prev;
+    }
+    if (t.count < CorrelationTrack::kMaxEntries) t.entries[t.count++] = {g, t.own_total, 1.f};
+    t.next_pdf = pdf_fwd;
+    t.next_specular = false;
+    t.seg_cos = cos_out;
+  }
 }
 
 void MisRules::scale_vcm(MisSums& s, float q) const {
   if (q != 1.f) s.vcm = times(s.vcm, mis(q));
+}
+
+void MisRules::enable_correlation(float acceptance_area, float min_factor) {
+  corr_area_ = acceptance_area;
+  corr_min_ = min_factor;
+}
+
+float MisRules::acceptance(float area_density) const {
+  const float a = corr_area_ * area_density;
+  return a < 1.f ? std::max(a, 0.f) : 1.f;  // NaN (0 x inf) counts as 0
+}
+
+float MisRules::correlation(float cam, float light) const {
+  const float denominator = cam + light - cam * light;
+  if (!(denominator > 0)) return 1.f;  // both 0: nothing is shared
+  return std::max(cam / denominator, corr_min_);
+}
+
+void MisRules::correlation_camera_start(CorrelationTrack& t, float camera_pdf_w) const {
+  t.count = 0;
+  t.own_total = 1;
+  t.next_pdf = camera_pdf_w;
+  t.next_specular = false;
+  t.seg_cos = 0;
+  t.seg_dist2 = 1;
+}
+
+void MisRules::correlation_light_start(CorrelationTrack& t, float a_y0, float a_y1,
+                                       float cos_at_light, float dist2) const {
+  t.count = 0;
+  t.next_pdf = 0;
+  t.next_specular = false;
+  t.own_total = a_y0 * a_y1;
+  t.seg_cos = cos_at_light;
+  t.seg_dist2 = dist2;
+}
+
+float MisRules::reverse_acceptance(const CorrelationTrack& t, float pdf_rev_w) const {
+  return acceptance(pdf_rev_w * t.seg_cos / t.seg_dist2);
+}
+
+float MisRules::correlated_merges(const CorrelationTrack& t, bool camera_side, float here_scale,
+                                  float entries_scale, float a_rev_prev, float other) const {
+  auto factor = [&](float own, float others) {
+    return mis(camera_side ? correlation(own, others) : correlation(others, own));
+  };
+  float sum = here_scale > 0 ? here_scale * factor(t.own_total, other) : 0.f;
+  for (int i = 0; i < t.count; ++i) {
+    const CorrelationEntry& e = t.entries[i];
+    sum += times(times(entries_scale, e.term), factor(e.own, other * a_rev_prev * e.rev));
+  }
+  return sum;
 }
 
 void MisRules::add_beyond(TechniqueTerms& t, const MisSums& s, TechniqueClass rest_class,

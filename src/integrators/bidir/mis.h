@@ -26,6 +26,9 @@
 // The power heuristic squares every ratio and count (mis()).
 #pragma once
 
+#include <algorithm>
+#include <array>
+
 #include "integrators/integrator.h"
 
 namespace caustica::bidir {
@@ -54,6 +57,51 @@ struct MisCounts {
   }
 };
 
+// Correlation-aware MIS (Grittmann, Georgiev and Slusallek 2021, "Correlation-Aware Multiple
+// Importance Sampling for Bidirectional Rendering Algorithms"; vcm --correlation-aware-mis).
+// The merges of an iteration share its N light subpaths, so a merge at vertex x_i of a path is
+// worth fewer than the N pi r^2 independent samples the balance heuristic counts it as. Its
+// count is multiplied by c_i = cam_i / (cam_i + light_i - cam_i light_i), at least 1 / N, where
+// cam_i is the product over the vertices from the first camera hit to x_i of
+// a = min(1, A p_camera(x)) and light_i the product from the emitter to x_i of
+// min(1, A p_light(x)): the acceptance probabilities, in a disc of area A = pi r^2, of the
+// area densities with which each side samples the vertex (1 for a vertex sampled through a
+// delta lobe, for a delta or infinite light's position). c_i needs both products of the whole
+// path, which the partial sums cannot carry, so each subpath also keeps its merges one by one
+// (CorrelationTrack): a merge's term of MisSums::merge, its own side's product and the product
+// of the reverse acceptances behind the subpath's last vertex. A technique completes them with
+// the other side's product and the acceptances its connection defines
+// (MisRules::correlated_merges), in O(vertices). The tests' brute-force oracle multiplies the
+// same products out over the explicit path.
+struct CorrelationEntry {
+  float term;  // the merge's share of MisSums::merge
+  float own;   // its side's product of acceptances from the subpath's start to the vertex
+  float rev;   // the reverse acceptances of the vertex and the later ones, up to the
+               // subpath's second-to-last vertex
+};
+struct CorrelationTrack {
+  // Non-delta vertices of a subpath: --max-depth at most this.
+  static constexpr int kMaxEntries = 128;
+  CorrelationTrack() {}  // the entries beyond count stay uninitialised (1.5 kB)
+  std::array<CorrelationEntry, kMaxEntries> entries;
+  int count = 0;
+  float own_total = 1;         // the own-direction product up to the last vertex, included
+  float next_pdf = 0;          // solid-angle density of the sample leaving the last vertex
+  bool next_specular = false;  // that sample came from a delta lobe
+  float seg_cos = 0;           // |cos| at the vertex before the last, toward the last
+  float seg_dist2 = 1;         // squared distance between those two vertices
+  // A copy of o that copies only its entries in use.
+  void assign(const CorrelationTrack& o) {
+    std::copy_n(o.entries.begin(), o.count, entries.begin());
+    count = o.count;
+    own_total = o.own_total;
+    next_pdf = o.next_pdf;
+    next_specular = o.next_specular;
+    seg_cos = o.seg_cos;
+    seg_dist2 = o.seg_dist2;
+  }
+};
+
 // The partial sums a subpath carries to its last vertex, without counts.
 struct MisSums {
   float vcm = 0;      // dVCM: the vertex's own reverse-sampling ratio (tech. rep. section 4)
@@ -67,6 +115,9 @@ struct MisSums {
   // non-delta lobe, once there is one (past_delta_chain).
   float first_merge = 0;
   bool past_delta_chain = false;
+  // The subpath's merges one by one, kept in step by MisRules::hit and scatter (correlation-
+  // aware MIS only; nullptr otherwise).
+  CorrelationTrack* corr = nullptr;
 };
 
 // The other techniques of one path relative to the current one, sum_k p_k / p_current by class
@@ -143,6 +194,30 @@ class MisRules {
   // hit's next event term (hit_light's nee_probability). q = 1 changes nothing, bit for bit.
   void scale_vcm(MisSums& s, float q) const;
 
+  // Correlation-aware MIS (see CorrelationTrack): acceptance area A = pi r^2 and the least
+  // factor 1 / N. Off (A = 0) unless enabled.
+  void enable_correlation(float acceptance_area, float min_factor);
+  bool correlated() const { return corr_area_ > 0; }
+  // min(1, A p) for an area density p (an infinite density, a delta lobe's, gives 1).
+  float acceptance(float area_density) const;
+  // c = cam / (cam + light - cam light), at least 1 / N.
+  float correlation(float cam, float light) const;
+  // A camera subpath starts (before the hit() of its first vertex): camera_pdf_w as camera_start.
+  void correlation_camera_start(CorrelationTrack& t, float camera_pdf_w) const;
+  // A light subpath at its first vertex y1: the acceptances of the emission point y0 and of y1.
+  void correlation_light_start(CorrelationTrack& t, float a_y0, float a_y1, float cos_at_light,
+                               float dist2) const;
+  // The acceptance of the vertex before the subpath's last, sampled from the last one with the
+  // solid-angle density pdf_rev_w there.
+  float reverse_acceptance(const CorrelationTrack& t, float pdf_rev_w) const;
+  // The merge terms of one side of a technique's path (the sum that replaces its share of
+  // TechniqueTerms::merge): the merge at the side's last vertex with count factor here_scale
+  // (0: none), the ones behind it scaled by entries_scale (add_beyond's scale x mis(pdf_rev)),
+  // whose other-side product is other x a_rev_prev x their rev. `other`: the other side's
+  // product up to the side's last vertex, included. camera_side: t is a camera subpath's.
+  float correlated_merges(const CorrelationTrack& t, bool camera_side, float here_scale,
+                          float entries_scale, float a_rev_prev, float other) const;
+
   // The terms of each way a path is completed (eq. 37 with counts); weight = terms.weight().
   // Camera subpath hits an emitter (s = 0): direct_pdf in the measure of light_first_hit
   // (area, or solid angle for infinite lights), emission_pdf = pmf * pdf_pos * pdf_dir.
@@ -188,6 +263,7 @@ class MisRules {
 
   bool power_;
   MisCounts counts_;  // through mis()
+  float corr_area_ = 0, corr_min_ = 0;
 };
 
 }  // namespace caustica::bidir

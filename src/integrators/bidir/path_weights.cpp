@@ -24,10 +24,13 @@ TechniqueWeight weight_of(const MisRules& rules, bool merge, int s, int t,
 }
 }  // namespace
 
-std::vector<TechniqueWeight> production_weights(
-    const Scene& scene, BidirAlgorithm algorithm, MisHeuristic heuristic, float light_paths,
-    float radius, const ExplicitPath& path, ScratchArena& arena, float raster_density,
-    int connections, bool pixel_merges, const BidirGuiding* guiding, float merge_mis_scale) {
+std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
+                                                MisHeuristic heuristic, float light_paths,
+                                                float radius, const ExplicitPath& path,
+                                                ScratchArena& arena, float raster_density,
+                                                int connections, bool pixel_merges,
+                                                const BidirGuiding* guiding, float merge_mis_scale,
+                                                bool correlation_aware) {
   const bool connect = algorithm != BidirAlgorithm::Bpm;
   const bool merge =
       algorithm != BidirAlgorithm::Bpt && algorithm != BidirAlgorithm::GuidedBpt && pixel_merges;
@@ -36,7 +39,9 @@ std::vector<TechniqueWeight> production_weights(
   counts.light_trace = connect ? light_paths : 0.f;
   counts.connect = connect ? float(connections) : 0.f;
   counts.merge = merge ? kPi * radius * radius * light_paths * merge_mis_scale : 0.f;
-  const MisRules rules(heuristic, counts);
+  MisRules rules(heuristic, counts);
+  if (correlation_aware && merge)
+    rules.enable_correlation(kPi * radius * radius, 1.f / light_paths);
   const Light& light = *path.light;
   const float pmf = scene.light_sampler().pmf(&light);
   const bool finite = !light.is_infinite();
@@ -97,12 +102,17 @@ std::vector<TechniqueWeight> production_weights(
   light.pdf_le(le.p, le.n, le.dir, &le.pdf_pos, &le.pdf_dir);
   le.cos_at_light = light.type() == LightType::Area ? abs_dot(le.n, le.dir) : 1.f;
   std::vector<MisSums> light_mis(k);
+  // Correlation-aware MIS: each subpath's merges at each of its vertices (mis.h).
+  std::vector<CorrelationTrack> light_tracks(k), camera_tracks(k);
   for (int i = 1; i < k; ++i) {
     if (i == 1) {
-      light_mis[1] = light_subpath_start(rules, light, pmf, le, light_si[1], distance(x[0], x[1]));
+      light_mis[1] = light_subpath_start(rules, light, pmf, le, light_si[1], distance(x[0], x[1]),
+                                         &light_tracks[1]);
       rules.scale_vcm(light_mis[1], probability(GuidingField::kNextEvent, 1, light_si[1].wo));
     } else {
       MisSums m = light_mis[i - 1];
+      light_tracks[i] = light_tracks[i - 1];
+      if (m.corr) m.corr = &light_tracks[i];
       const bool specular = delta(i - 1);
       const float pdf_fwd = specular ? 1.f
                                      : direction_pdf(bsdf[i - 1], guides[i - 1], light_si[i - 1].wo,
@@ -115,21 +125,29 @@ std::vector<TechniqueWeight> production_weights(
     }
   }
   auto stored = [&](int i) {
-    return unpack_light_vertex(
-               pack_light_vertex({x[i], light_si[i].wo, 0, i, Rgb(1.f), light_mis[i]}))
-        .mis;
+    MisSums m =
+        unpack_light_vertex(pack_light_vertex({x[i], light_si[i].wo, 0, i, Rgb(1.f), light_mis[i]}))
+            .mis;
+    m.corr = light_mis[i].corr;
+    return m;
   };
 
   // Camera subpath replay: sums at x(k-1) down to x1, and at the emitter (s = 0).
   std::vector<MisSums> camera_mis(k);
-  camera_mis[k - 1] =
-      rules.camera_start(camera_pdf_w(scene.camera(), x[k], dir(k, k - 1), raster_density));
+  const float pdf_camera = camera_pdf_w(scene.camera(), x[k], dir(k, k - 1), raster_density);
+  camera_mis[k - 1] = rules.camera_start(pdf_camera);
+  if (rules.correlated()) {
+    rules.correlation_camera_start(camera_tracks[k - 1], pdf_camera);
+    camera_mis[k - 1].corr = &camera_tracks[k - 1];
+  }
   rules.hit(camera_mis[k - 1], distance_squared(x[k], x[k - 1]),
             geometric_cos(camera_si[k - 1], dir(k - 1, k)));
   rules.scale_vcm(camera_mis[k - 1],
                   probability(GuidingField::kLensConnection, k - 1, camera_si[k - 1].wo));
   for (int i = k - 2; i >= 1; --i) {
     MisSums m = camera_mis[i + 1];
+    camera_tracks[i] = camera_tracks[i + 1];
+    if (m.corr) m.corr = &camera_tracks[i];
     const bool specular = delta(i + 1);
     const float pdf_fwd = specular ? 1.f
                                    : direction_pdf(bsdf[i + 1], guides[i + 1], camera_si[i + 1].wo,
@@ -146,6 +164,8 @@ std::vector<TechniqueWeight> production_weights(
   // s = 0: the camera subpath hits the emitter.
   if (connect && !light.is_delta()) {
     MisSums m = camera_mis[1];
+    CorrelationTrack emitter_track = camera_tracks[1];
+    if (m.corr) m.corr = &emitter_track;
     const bool specular = delta(1);
     const float pdf_fwd = specular ? 1.f
                                    : direction_pdf(bsdf[1], guides[1], camera_si[1].wo, to_light,

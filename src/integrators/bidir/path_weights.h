@@ -49,12 +49,11 @@ struct TechniqueWeight {
 // guiding: the learned fields of guided-bpt / guided-vcm (their vertices' densities are the
 // guided mixtures'); nullptr: unguided.
 // merge_mis_scale: --merge-mis-scale, the factor of the merges' count N pi r^2 in the weights.
-std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorithm algorithm,
-                                                MisHeuristic heuristic, float light_paths,
-                                                float radius, const ExplicitPath& path,
-                                                ScratchArena& arena, float raster_density = 1.f,
-                                                int connections = 1, bool pixel_merges = true,
-                                                const BidirGuiding* guiding = nullptr,
-                                                float merge_mis_scale = 1.f);
+// correlation_aware: --merge-mis correlation-aware (vcm).
+std::vector<TechniqueWeight> production_weights(
+    const Scene& scene, BidirAlgorithm algorithm, MisHeuristic heuristic, float light_paths,
+    float radius, const ExplicitPath& path, ScratchArena& arena, float raster_density = 1.f,
+    int connections = 1, bool pixel_merges = true, const BidirGuiding* guiding = nullptr,
+    float merge_mis_scale = 1.f, bool correlation_aware = false);
 
 }  // namespace caustica::bidir

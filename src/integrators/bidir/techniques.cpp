@@ -5,6 +5,11 @@
 
 namespace caustica::bidir {
 
+namespace {
+// a x b with 0 x inf = 0, as the partial sums multiply (mis.cpp).
+float times_or_zero(float a, float b) { return a == 0.f || b == 0.f ? 0.f : a * b; }
+}  // namespace
+
 float camera_pdf_w(const Camera& camera, Vec3 p_lens, Vec3 dir, float raster_density) {
   float pdf_pos, pdf_dir;
   camera.pdf_we(p_lens, dir, &pdf_pos, &pdf_dir);
@@ -15,7 +20,8 @@ float camera_pdf_w(const Camera& camera, Vec3 p_lens, Vec3 dir, float raster_den
 }
 
 MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf,
-                            const LightLeSample& le, const SurfaceInteraction& y1, float dist) {
+                            const LightLeSample& le, const SurfaceInteraction& y1, float dist,
+                            CorrelationTrack* track) {
   const bool finite = !light.is_infinite();
   const float dist2 = dist * dist;
   float direct;
@@ -27,8 +33,19 @@ MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf
     direct = pmf * light.pdf_li(y1.p, -le.dir, {}, {});
   }
   const float emission = pmf * le.pdf_pos * le.pdf_dir;
-  return rules.light_first_hit(direct, emission, le.cos_at_light, light.is_delta(), finite, dist2,
-                               geometric_cos(y1, le.dir));
+  MisSums s = rules.light_first_hit(direct, emission, le.cos_at_light, light.is_delta(), finite,
+                                    dist2, geometric_cos(y1, le.dir));
+  if (track && rules.correlated()) {
+    // y0: an area light's point (area density pmf pdf_pos); a delta or infinite light's has
+    // none to accept (1). y1: the emitted direction's density in area measure, or for an
+    // infinite light the density of the ray's origin on the disc, times |cos| at y1.
+    const float a_y0 = finite && !light.is_delta() ? rules.acceptance(pmf * le.pdf_pos) : 1.f;
+    const float cos_y1 = geometric_cos(y1, le.dir);
+    const float a_y1 = rules.acceptance(finite ? le.pdf_dir * cos_y1 / dist2 : le.pdf_pos * cos_y1);
+    rules.correlation_light_start(*track, a_y0, a_y1, le.cos_at_light, dist2);
+    s.corr = track;
+  }
+  return s;
 }
 
 void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteraction& si,
@@ -54,7 +71,18 @@ TechniqueTerms terms_emitter_hit(const MisRules& rules, const Light& light, floa
     light.pdf_le({}, {}, -dir, &pdf_pos, &pdf_dir);
     direct = pmf * light.pdf_li(prev_p, dir, {}, {});
   }
-  return rules.hit_light(camera, direct, pmf * pdf_pos * pdf_dir, nee_probability);
+  TechniqueTerms t = rules.hit_light(camera, direct, pmf * pdf_pos * pdf_dir, nee_probability);
+  if (camera.corr && rules.correlated()) {
+    // The light subpath is the emitter alone; the camera vertex before it is sampled by the
+    // emission direction (area measure), or for an infinite light by the disc (|cos| only).
+    const CorrelationTrack& c = *camera.corr;
+    const float a_y0 = hit ? rules.acceptance(pmf * pdf_pos) : 1.f;
+    const float a_prev =
+        rules.acceptance(hit ? pdf_dir * c.seg_cos / c.seg_dist2 : pdf_pos * c.seg_cos);
+    t.merge =
+        rules.correlated_merges(c, true, 0.f, rules.mis(pmf * pdf_pos * pdf_dir), a_prev, a_y0);
+  }
+  return t;
 }
 
 TechniqueTerms terms_light_seen_from_lens(const MisRules& rules, const Light& light, float pmf,
@@ -77,8 +105,23 @@ TechniqueTerms terms_next_event(const MisRules& rules, const Light& light, float
   const float direct_w =
       pmf * (light.type() == LightType::DeltaPosition ? ls.distance * ls.distance : ls.pdf_w);
   const float emission_w = pmf * ls.pdf_emit_pos * ls.pdf_emit_dir;
-  return rules.next_event(camera, bsdf_fwd, bsdf_rev, direct_w, emission_w,
-                          geometric_cos(si, ls.wi), ls.cos_at_light);
+  const float cos_to_light = geometric_cos(si, ls.wi);
+  TechniqueTerms t = rules.next_event(camera, bsdf_fwd, bsdf_rev, direct_w, emission_w,
+                                      cos_to_light, ls.cos_at_light);
+  if (camera.corr && rules.correlated()) {
+    // The light side: the emitter's point and this vertex as the emission samples it.
+    const bool finite = !light.is_infinite();
+    const float a_y0 =
+        light.type() == LightType::Area ? rules.acceptance(pmf * ls.pdf_emit_pos) : 1.f;
+    const float a_x =
+        rules.acceptance(finite ? ls.pdf_emit_dir * cos_to_light / (ls.distance * ls.distance)
+                                : ls.pdf_emit_pos * cos_to_light);
+    const float scale = rules.mis(emission_w * cos_to_light / (direct_w * ls.cos_at_light));
+    t.merge = rules.correlated_merges(*camera.corr, true, scale,
+                                      times_or_zero(scale, rules.mis(bsdf_rev)),
+                                      rules.reverse_acceptance(*camera.corr, bsdf_rev), a_y0 * a_x);
+  }
+  return t;
 }
 
 TechniqueTerms terms_connection(const MisRules& rules, const SurfaceInteraction& light_si,
@@ -100,7 +143,18 @@ TechniqueTerms terms_connection(const MisRules& rules, const SurfaceInteraction&
       direction_pdf(light_bsdf, lg, light_wo, -dir, TransportMode::Importance) *
       geometric_cos(camera_si, dir) / dist2;
   const float light_rev = direction_pdf(light_bsdf, lg, -dir, light_wo, TransportMode::Radiance);
-  return rules.connect(light, camera, camera_pdf_a, camera_rev, light_pdf_a, light_rev);
+  TechniqueTerms t = rules.connect(light, camera, camera_pdf_a, camera_rev, light_pdf_a, light_rev);
+  if (light.corr && camera.corr && rules.correlated()) {
+    const float cs = rules.mis(camera_pdf_a), ls = rules.mis(light_pdf_a);
+    t.merge =
+        rules.correlated_merges(*light.corr, false, cs, times_or_zero(cs, rules.mis(light_rev)),
+                                rules.reverse_acceptance(*light.corr, light_rev),
+                                camera.corr->own_total * rules.acceptance(camera_pdf_a)) +
+        rules.correlated_merges(*camera.corr, true, ls, times_or_zero(ls, rules.mis(camera_rev)),
+                                rules.reverse_acceptance(*camera.corr, camera_rev),
+                                light.corr->own_total * rules.acceptance(light_pdf_a));
+  }
+  return t;
 }
 
 namespace {
@@ -132,7 +186,16 @@ LensConnection lens_connection(const Camera& camera, const SurfaceInteraction& s
 
 TechniqueTerms terms_light_to_camera(const MisRules& rules, const LensConnection& c,
                                      const MisSums& light, float raster_density) {
-  return rules.light_to_camera(light, camera_pdf_a(c, raster_density), c.rev);
+  const float pdf_a = camera_pdf_a(c, raster_density);
+  TechniqueTerms t = rules.light_to_camera(light, pdf_a, c.rev);
+  if (light.corr && rules.correlated()) {
+    // The camera side is the lens alone: its product is the light vertex's acceptance.
+    const float cs = rules.mis(pdf_a);
+    t.merge = rules.correlated_merges(*light.corr, false, cs, times_or_zero(cs, rules.mis(c.rev)),
+                                      rules.reverse_acceptance(*light.corr, c.rev),
+                                      rules.acceptance(pdf_a));
+  }
+  return t;
 }
 
 TechniqueTerms terms_light_to_camera(const MisRules& rules, const Camera& camera,
@@ -155,7 +218,17 @@ TechniqueTerms terms_merge(const MisRules& rules, Vec3 light_wo, const MisSums& 
   const float fwd = direction_pdf(camera_bsdf, g, camera_si.wo, light_wo, TransportMode::Radiance);
   const float rev =
       direction_pdf(camera_bsdf, g, light_wo, camera_si.wo, TransportMode::Importance);
-  return rules.merge(light, camera, fwd, rev);
+  TechniqueTerms t = rules.merge(light, camera, fwd, rev);
+  if (light.corr && camera.corr && rules.correlated()) {
+    // The merged vertex is the camera side's last and the light side's last.
+    const float cam = camera.corr->own_total, lig = light.corr->own_total;
+    t.merge = rules.correlated_merges(*light.corr, false, 0.f, rules.mis(fwd),
+                                      rules.reverse_acceptance(*light.corr, fwd), cam) +
+              rules.correlated_merges(*camera.corr, true, 0.f, rules.mis(rev),
+                                      rules.reverse_acceptance(*camera.corr, rev), lig);
+    t.own_factor = rules.mis(rules.correlation(cam, lig));
+  }
+  return t;
 }
 
 }  // namespace caustica::bidir

@@ -31,8 +31,11 @@ inline float geometric_cos(const SurfaceInteraction& si, Vec3 w) { return abs_do
 float camera_pdf_w(const Camera& camera, Vec3 p_lens, Vec3 dir, float raster_density = 1.f);
 
 // MIS sums at the first light vertex y1, reached at distance dist from the emission sample.
+// track: the subpath's merges for correlation-aware MIS (started here, and the sums' corr),
+// when the rules are correlated.
 MisSums light_subpath_start(const MisRules& rules, const Light& light, float pmf,
-                            const LightLeSample& le, const SurfaceInteraction& y1, float dist);
+                            const LightLeSample& le, const SurfaceInteraction& y1, float dist,
+                            CorrelationTrack* track = nullptr);
 // Scattering at si from wo into wi; pdf_fwd is the sample's pdf (ignored for specular bounces).
 void scatter_update(const MisRules& rules, MisSums& mis, const SurfaceInteraction& si,
                     const Bsdf& bsdf, Vec3 wo, Vec3 wi, TransportMode mode, bool specular,

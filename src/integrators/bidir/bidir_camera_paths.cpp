@@ -89,7 +89,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   MisSums mis = rules.camera_start(pdf_camera);
   // Correlation-aware MIS: the subpath's merges one by one, for `mis` and for the sums at the
   // current hit (mis.h, CorrelationTrack).
-  std::optional<CorrelationTrack> track, track_at_hit;
+  std::optional<OwnedCorrelationTrack> track, track_at_hit;
   if (rules.correlated()) {
     track.emplace();
     track_at_hit.emplace();
@@ -310,9 +310,8 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
         arena.allocate(sizeof(RebuiltLightVertex) * (end - first), alignof(RebuiltLightVertex)));
     std::uninitialized_default_construct_n(acc.own_path, end - first);
   }
-  RebuiltLightVertex scratch;  // a vertex of another light path, rebuilt for this connection
-  std::optional<CorrelationTrack> light_track;  // correlation-aware MIS
-  if (rules.correlated()) light_track.emplace();
+  RebuiltLightVertex scratch;    // a vertex of another light path, rebuilt for this connection
+  CorrelationTrack light_track;  // correlation-aware MIS: a stored vertex's (load_track)
   for (uint32_t i = first; i < end; ++i) {
     const LightVertex& stored = vertices_[i];
     // Stored in increasing depth: once too long, all the rest are too.
@@ -360,9 +359,9 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
                                !occluded);
     if (occluded) continue;
     MisSums light_mis = v.mis;
-    if (light_track) {
-      load_track(i, &*light_track);
-      light_mis.corr = &*light_track;
+    if (rules.correlated()) {
+      load_track(i, &light_track);
+      light_mis.corr = &light_track;
     }
     TechniqueTerms terms = terms_connection(rules, light_si, light_bsdf, v.wo, light_mis, si, bsdf,
                                             cv.mis, rebuilt.guides, cv.guides);
@@ -387,41 +386,50 @@ void BidirIntegrator::merge(const Scene& scene, const Iteration& it, const MisRu
   const int max_depth = settings_.max_depth;
   const Scene::PrimitiveRange own_shape = scene.shape_primitives(si);
   const float max_off_plane = 0.5f * it.radius;
-  std::optional<CorrelationTrack> light_track;  // correlation-aware MIS
-  if (rules.correlated()) light_track.emplace();
-  grid_.for_each_near(si.p, vertices_, [&](uint32_t index, Vec3 q) {
-    ++acc.work.photons;
-    acc.work.stop_photons += stop_query;
-    const LightVertex& stored = vertices_[index];
-    const int light_depth = light_vertex_depth(stored);
-    if (light_depth + depth - 1 > max_depth) return;
-    if (std::abs(dot(q - si.p, si.ng)) > max_off_plane) return;
-    LightVertexData v = unpack_light_vertex(stored);
-    // The photon's throughput carries the flux through the surface (geometric cosine); the
-    // camera vertex integrates with the shading cosine: |ns . wi| / |ng . wi|, as NEE and
-    // connections have it through abs_cos (Veach 1997, section 5.3).
-    const float cos_geometric = geometric_cos(si, v.wo);
-    if (!(cos_geometric > 0)) return;
-    const Rgb f =
-        bsdf.f(si.wo, v.wo, TransportMode::Radiance) * (bsdf.abs_cos(v.wo) / cos_geometric);
-    if (f.is_black()) return;
-    if (!own_shape.contains(v.primitive) &&
-        !photon_visible(scene, si, v.primitive, q, v.wo, it.radius))
-      return;
-    if (acc.stops) {  // a pixel no probe records: no terms needed
-      acc.add(true, light_depth + 1, depth + 1,
-              cv.beta * f * v.throughput * it.merge_normalization);
-      return;
-    }
-    if (light_track) {
-      load_track(index, &*light_track);
-      v.mis.corr = &*light_track;
-    }
-    const TechniqueTerms terms = terms_merge(rules, v.wo, v.mis, si, bsdf, cv.mis, cv.guides);
-    const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
-    acc.add(true, light_depth + 1, depth + 1,
-            cv.beta * f * v.throughput * (w * it.merge_normalization), &terms);
-  });
+  CorrelationTrack light_track;  // correlation-aware MIS: a stored vertex's (load_track)
+  grid_.for_each_near(
+      si.p, vertices_,
+      [&](uint32_t index, Vec3 q) {
+        ++acc.work.photons;
+        acc.work.stop_photons += stop_query;
+        const LightVertex& stored = vertices_[index];
+        const int light_depth = light_vertex_depth(stored);
+        if (light_depth + depth - 1 > max_depth) return;
+        if (std::abs(dot(q - si.p, si.ng)) > max_off_plane) return;
+        LightVertexData v = unpack_light_vertex(stored);
+        // The photon's throughput carries the flux through the surface (geometric cosine); the
+        // camera vertex integrates with the shading cosine: |ns . wi| / |ng . wi|, as NEE and
+        // connections have it through abs_cos (Veach 1997, section 5.3).
+        const float cos_geometric = geometric_cos(si, v.wo);
+        if (!(cos_geometric > 0)) return;
+        const Rgb f =
+            bsdf.f(si.wo, v.wo, TransportMode::Radiance) * (bsdf.abs_cos(v.wo) / cos_geometric);
+        if (f.is_black()) return;
+        if (!own_shape.contains(v.primitive) &&
+            !photon_visible(scene, si, v.primitive, q, v.wo, it.radius))
+          return;
+        if (acc.stops) {  // a pixel no probe records: no terms needed
+          acc.add(true, light_depth + 1, depth + 1,
+                  cv.beta * f * v.throughput * it.merge_normalization);
+          return;
+        }
+        if (rules.correlated()) {
+          load_track(index, &light_track);
+          v.mis.corr = &light_track;
+        }
+        const TechniqueTerms terms = terms_merge(rules, v.wo, v.mis, si, bsdf, cv.mis, cv.guides);
+        const float w = tech_.unweighted ? 1.f : terms.weight(rules.counts());
+        acc.add(true, light_depth + 1, depth + 1,
+                cv.beta * f * v.throughput * (w * it.merge_normalization), &terms);
+      },
+      [&](uint32_t index, int stage) {
+        if (!rules.correlated()) return;
+        const StoredTrack& t = tracks_[index];
+        if (stage == 0)
+          __builtin_prefetch(&t);
+        else if (t.count > StoredTrack::kInline)
+          __builtin_prefetch(track_entries_.data() + t.first);
+      });
 }
 
 bool BidirIntegrator::photon_visible(const Scene& scene, const SurfaceInteraction& si,

@@ -62,11 +62,19 @@ struct Splat {
 // Scalar of a contribution for the adaptive plan's moments.
 inline float scalar(Rgb v) { return (v.r + v.g + v.b) * (1.f / 3.f); }
 
-// A stored light vertex's CorrelationTrack (correlation-aware MIS): its entries in a pool.
-struct StoredTrack {
-  uint32_t first = 0, count = 0;  // entries in the pool
+// A stored light vertex's CorrelationTrack (correlation-aware MIS), one cache line per vertex
+// at the vertex's index: up to kInline entries in the line itself, more in a pool (first). A
+// merge reads it for every photon it accepts, in random order: one miss, prefetched when the
+// range search finds the photon (a pool of all entries took a second, dependent miss that
+// was most of the correlation's cost).
+struct alignas(64) StoredTrack {
+  static constexpr uint32_t kInline = 3;
   float own_total = 1, seg_cos = 0, seg_dist2 = 1;
+  uint32_t count = 0;
+  uint32_t first = 0;  // in the pool, when count > kInline
+  CorrelationEntry inline_entries[kInline];
 };
+static_assert(sizeof(StoredTrack) == 64, "a stored track is meant to fill one cache line");
 
 // What one chunk of light paths leaves behind.
 struct LightChunk {

@@ -124,7 +124,7 @@ void BidirIntegrator::append_chunk(const Iteration& it, const LightChunk& chunk)
   if (!chunk.tracks.empty()) {
     const uint32_t entries_base = uint32_t(track_entries_.size());
     for (StoredTrack t : chunk.tracks) {
-      t.first += entries_base;
+      if (t.count > StoredTrack::kInline) t.first += entries_base;
       tracks_.push_back(t);
     }
     track_entries_.insert(track_entries_.end(), chunk.track_entries.begin(),
@@ -147,7 +147,10 @@ void BidirIntegrator::append_chunk(const Iteration& it, const LightChunk& chunk)
 void BidirIntegrator::load_track(uint32_t index, CorrelationTrack* out) const {
   const StoredTrack& t = tracks_[index];
   out->count = int(t.count);
-  std::copy_n(track_entries_.begin() + t.first, t.count, out->entries.begin());
+  // Techniques only read a light vertex's entries (MisRules::correlated_merges).
+  out->entries = t.count > StoredTrack::kInline
+                     ? const_cast<CorrelationEntry*>(track_entries_.data()) + t.first
+                     : const_cast<CorrelationEntry*>(t.inline_entries);
   out->own_total = t.own_total;
   out->seg_cos = t.seg_cos;
   out->seg_dist2 = t.seg_dist2;
@@ -181,7 +184,7 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
   Rgb seen(0.f);  // the unweighted lens connections so far
   MisSums mis;
   // Correlation-aware MIS: the subpath's merges one by one (mis.corr points here).
-  std::optional<CorrelationTrack> track;
+  std::optional<OwnedCorrelationTrack> track;
   if (it.rules.correlated()) track.emplace();
   float segment = 0;  // distance since the previous real vertex (interfaces are skipped)
   int depth = 0;
@@ -217,10 +220,19 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
         chunk.vertices.push_back(
             pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}));
         if (track) {
-          chunk.tracks.push_back({uint32_t(chunk.track_entries.size()), uint32_t(track->count),
-                                  track->own_total, track->seg_cos, track->seg_dist2});
-          chunk.track_entries.insert(chunk.track_entries.end(), track->entries.begin(),
-                                     track->entries.begin() + track->count);
+          StoredTrack t;
+          t.own_total = track->own_total;
+          t.seg_cos = track->seg_cos;
+          t.seg_dist2 = track->seg_dist2;
+          t.count = uint32_t(track->count);
+          if (t.count > StoredTrack::kInline) {
+            t.first = uint32_t(chunk.track_entries.size());
+            chunk.track_entries.insert(chunk.track_entries.end(), track->entries,
+                                       track->entries + track->count);
+          } else {
+            std::copy_n(track->entries, t.count, t.inline_entries);
+          }
+          chunk.tracks.push_back(t);
         }
       }
       if (tech_.light_to_camera) {

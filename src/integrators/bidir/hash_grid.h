@@ -29,9 +29,13 @@ class HashGrid {
   // table_size: buckets (rounded up to a power of two); 0 = about a quarter of the vertex count.
   void build(const std::vector<LightVertex>& vertices, float radius, uint32_t table_size = 0);
 
-  // fn(vertex_index, light_position) for every vertex within the radius of p.
-  template <typename Fn>
-  void for_each_near(Vec3 p, const std::vector<LightVertex>& vertices, Fn&& fn) const {
+  // fn(vertex_index, light_position) for every vertex within the radius of p. For records the
+  // caller keeps beside the vertices, prefetch(index, 0) when a vertex is found and
+  // prefetch(index, 1) when its batch is about to be handed to fn (a second, dependent load).
+  template <typename Fn, typename Prefetch = void (*)(uint32_t, int)>
+  void for_each_near(
+      Vec3 p, const std::vector<LightVertex>& vertices, Fn&& fn,
+      Prefetch&& prefetch = [](uint32_t, int) {}) const {
     if (cell_start_.empty()) return;
     uint32_t begin[8], end[8];
     const int count = buckets_near(p, begin, end);
@@ -42,6 +46,7 @@ class HashGrid {
     uint32_t found[kBatch];
     uint32_t n = 0;
     auto flush = [&] {
+      for (uint32_t j = 0; j < n; ++j) prefetch(entries_[found[j]].index, 1);
       for (uint32_t j = 0; j < n; ++j) {
         const Entry& e = entries_[found[j]];
         fn(e.index, Vec3(e.p[0], e.p[1], e.p[2]));
@@ -53,6 +58,7 @@ class HashGrid {
         const Entry& e = entries_[i];
         if (distance_squared(p, Vec3(e.p[0], e.p[1], e.p[2])) > radius2_) continue;
         __builtin_prefetch(&vertices[e.index]);
+        prefetch(e.index, 0);
         found[n++] = i;
         if (n == kBatch) flush();
       }

@@ -82,17 +82,18 @@ struct CorrelationEntry {
 struct CorrelationTrack {
   // Non-delta vertices of a subpath: --max-depth at most this.
   static constexpr int kMaxEntries = 128;
-  CorrelationTrack() {}  // the entries beyond count stay uninitialised (1.5 kB)
-  std::array<CorrelationEntry, kMaxEntries> entries;
+  // A live subpath's own storage (OwnedCorrelationTrack, room for kMaxEntries), or a stored
+  // light vertex's entries in the integrator's pool, which nothing writes through.
+  CorrelationEntry* entries = nullptr;
   int count = 0;
   float own_total = 1;         // the own-direction product up to the last vertex, included
   float next_pdf = 0;          // solid-angle density of the sample leaving the last vertex
   bool next_specular = false;  // that sample came from a delta lobe
   float seg_cos = 0;           // |cos| at the vertex before the last, toward the last
   float seg_dist2 = 1;         // squared distance between those two vertices
-  // A copy of o that copies only its entries in use.
+  // A copy of o into this track's storage, of the entries in use only.
   void assign(const CorrelationTrack& o) {
-    std::copy_n(o.entries.begin(), o.count, entries.begin());
+    std::copy_n(o.entries, o.count, entries);
     count = o.count;
     own_total = o.own_total;
     next_pdf = o.next_pdf;
@@ -100,6 +101,17 @@ struct CorrelationTrack {
     seg_cos = o.seg_cos;
     seg_dist2 = o.seg_dist2;
   }
+};
+// A track with its own room for kMaxEntries entries (1.5 kB, left uninitialised); copies copy
+// the entries in use.
+struct OwnedCorrelationTrack : CorrelationTrack {
+  OwnedCorrelationTrack() { entries = storage.data(); }
+  OwnedCorrelationTrack(const OwnedCorrelationTrack& o) : OwnedCorrelationTrack() { assign(o); }
+  OwnedCorrelationTrack& operator=(const OwnedCorrelationTrack& o) {
+    assign(o);
+    return *this;
+  }
+  std::array<CorrelationEntry, kMaxEntries> storage;
 };
 
 // The partial sums a subpath carries to its last vertex, without counts.

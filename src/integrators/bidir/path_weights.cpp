@@ -103,7 +103,7 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   le.cos_at_light = light.type() == LightType::Area ? abs_dot(le.n, le.dir) : 1.f;
   std::vector<MisSums> light_mis(k);
   // Correlation-aware MIS: each subpath's merges at each of its vertices (mis.h).
-  std::vector<CorrelationTrack> light_tracks(k), camera_tracks(k);
+  std::vector<OwnedCorrelationTrack> light_tracks(k), camera_tracks(k);
   for (int i = 1; i < k; ++i) {
     if (i == 1) {
       light_mis[1] = light_subpath_start(rules, light, pmf, le, light_si[1], distance(x[0], x[1]),
@@ -164,7 +164,7 @@ std::vector<TechniqueWeight> production_weights(const Scene& scene, BidirAlgorit
   // s = 0: the camera subpath hits the emitter.
   if (connect && !light.is_delta()) {
     MisSums m = camera_mis[1];
-    CorrelationTrack emitter_track = camera_tracks[1];
+    OwnedCorrelationTrack emitter_track = camera_tracks[1];
     if (m.corr) m.corr = &emitter_track;
     const bool specular = delta(1);
     const float pdf_fwd = specular ? 1.f

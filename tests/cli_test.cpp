@@ -85,6 +85,10 @@ TEST(Cli, CorrelationAwareMisRefusesDepthsItCannotHoldAndUnknownValues) {
           d);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(fs::exists(d / "out.exr"));
+  std::ifstream f(d / "out.json");
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["bidir"]["merge_mis"], "correlation-aware");
+  EXPECT_GT(j["bidir"]["correlation_track_bytes"].get<double>(), 0.0);
 }
 
 TEST(Cli, MissingFileIsAnErrorNamingIt) {

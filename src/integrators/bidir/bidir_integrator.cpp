@@ -286,6 +286,12 @@ void BidirIntegrator::report(nlohmann::json& stats) const {
   b["bytes_per_light_vertex"] = sizeof(LightVertex);
   b["light_vertex_buffer_bytes"] = vertices_.capacity() * sizeof(LightVertex);
   b["hash_grid_bytes"] = grid_.memory_bytes();
+  if (algorithm_ == BidirAlgorithm::Vcm) {
+    b["merge_mis"] = correlation_aware() ? "correlation-aware" : "balance";
+    if (correlation_aware())  // the light vertices' tracks (64 bytes each, longer ones pooled)
+      b["correlation_track_bytes"] = tracks_.capacity() * sizeof(StoredTrack) +
+                                     track_entries_.capacity() * sizeof(CorrelationEntry);
+  }
   if (tech_.merge)
     b["hash_grid_build_ms_per_iteration"] =
         iterations_ ? 1e3 * grid_seconds_total_ / iterations_ : 0.0;

@@ -182,7 +182,8 @@ void MisRules::enable_correlation(float acceptance_area, float min_factor) {
 
 float MisRules::acceptance(float area_density) const {
   const float a = corr_area_ * area_density;
-  return a < 1.f ? std::max(a, 0.f) : 1.f;  // NaN (0 x inf) counts as 0
+  if (a >= 1.f) return 1.f;  // an infinite density too
+  return a > 0.f ? a : 0.f;  // NaN (0 x inf) counts as 0
 }
 
 float MisRules::correlation(float cam, float light) const {

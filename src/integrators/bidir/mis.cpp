@@ -228,6 +228,12 @@ float MisRules::correlated_merges(const CorrelationTrack& t, bool camera_side, f
   return sum;
 }
 
+float MisRules::correlated_beyond(const CorrelationTrack& t, bool camera_side, float scale,
+                                  float pdf_rev, bool with_merge_here, float other) const {
+  return correlated_merges(t, camera_side, with_merge_here ? scale : 0.f,
+                           times(scale, mis(pdf_rev)), reverse_acceptance(t, pdf_rev), other);
+}
+
 void MisRules::add_beyond(TechniqueTerms& t, const MisSums& s, TechniqueClass rest_class,
                           float scale, float pdf_rev, bool with_merge_here) const {
   if (with_merge_here) t.merge += scale;

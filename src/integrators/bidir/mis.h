@@ -229,6 +229,11 @@ class MisRules {
   // product up to the side's last vertex, included. camera_side: t is a camera subpath's.
   float correlated_merges(const CorrelationTrack& t, bool camera_side, float here_scale,
                           float entries_scale, float a_rev_prev, float other) const;
+  // The same with add_beyond's arguments (its merge part): the merge at the side's last vertex
+  // with `scale` where with_merge_here, the ones behind with scale x mis(pdf_rev) and the
+  // reverse acceptance of pdf_rev.
+  float correlated_beyond(const CorrelationTrack& t, bool camera_side, float scale, float pdf_rev,
+                          bool with_merge_here, float other) const;
 
   // The terms of each way a path is completed (eq. 37 with counts); weight = terms.weight().
   // Camera subpath hits an emitter (s = 0): direct_pdf in the measure of light_first_hit

@@ -5,11 +5,6 @@
 
 namespace caustica::bidir {
 
-namespace {
-// a x b with 0 x inf = 0, as the partial sums multiply (mis.cpp).
-float times_or_zero(float a, float b) { return a == 0.f || b == 0.f ? 0.f : a * b; }
-}  // namespace
-
 float camera_pdf_w(const Camera& camera, Vec3 p_lens, Vec3 dir, float raster_density) {
   float pdf_pos, pdf_dir;
   camera.pdf_we(p_lens, dir, &pdf_pos, &pdf_dir);
@@ -117,9 +112,7 @@ TechniqueTerms terms_next_event(const MisRules& rules, const Light& light, float
         rules.acceptance(finite ? ls.pdf_emit_dir * cos_to_light / (ls.distance * ls.distance)
                                 : ls.pdf_emit_pos * cos_to_light);
     const float scale = rules.mis(emission_w * cos_to_light / (direct_w * ls.cos_at_light));
-    t.merge = rules.correlated_merges(*camera.corr, true, scale,
-                                      times_or_zero(scale, rules.mis(bsdf_rev)),
-                                      rules.reverse_acceptance(*camera.corr, bsdf_rev), a_y0 * a_x);
+    t.merge = rules.correlated_beyond(*camera.corr, true, scale, bsdf_rev, true, a_y0 * a_x);
   }
   return t;
 }
@@ -145,14 +138,10 @@ TechniqueTerms terms_connection(const MisRules& rules, const SurfaceInteraction&
   const float light_rev = direction_pdf(light_bsdf, lg, -dir, light_wo, TransportMode::Radiance);
   TechniqueTerms t = rules.connect(light, camera, camera_pdf_a, camera_rev, light_pdf_a, light_rev);
   if (light.corr && camera.corr && rules.correlated()) {
-    const float cs = rules.mis(camera_pdf_a), ls = rules.mis(light_pdf_a);
-    t.merge =
-        rules.correlated_merges(*light.corr, false, cs, times_or_zero(cs, rules.mis(light_rev)),
-                                rules.reverse_acceptance(*light.corr, light_rev),
-                                camera.corr->own_total * rules.acceptance(camera_pdf_a)) +
-        rules.correlated_merges(*camera.corr, true, ls, times_or_zero(ls, rules.mis(camera_rev)),
-                                rules.reverse_acceptance(*camera.corr, camera_rev),
-                                light.corr->own_total * rules.acceptance(light_pdf_a));
+    t.merge = rules.correlated_beyond(*light.corr, false, rules.mis(camera_pdf_a), light_rev, true,
+                                      camera.corr->own_total * rules.acceptance(camera_pdf_a)) +
+              rules.correlated_beyond(*camera.corr, true, rules.mis(light_pdf_a), camera_rev, true,
+                                      light.corr->own_total * rules.acceptance(light_pdf_a));
   }
   return t;
 }
@@ -190,9 +179,7 @@ TechniqueTerms terms_light_to_camera(const MisRules& rules, const LensConnection
   TechniqueTerms t = rules.light_to_camera(light, pdf_a, c.rev);
   if (light.corr && rules.correlated()) {
     // The camera side is the lens alone: its product is the light vertex's acceptance.
-    const float cs = rules.mis(pdf_a);
-    t.merge = rules.correlated_merges(*light.corr, false, cs, times_or_zero(cs, rules.mis(c.rev)),
-                                      rules.reverse_acceptance(*light.corr, c.rev),
+    t.merge = rules.correlated_beyond(*light.corr, false, rules.mis(pdf_a), c.rev, true,
                                       rules.acceptance(pdf_a));
   }
   return t;
@@ -222,10 +209,8 @@ TechniqueTerms terms_merge(const MisRules& rules, Vec3 light_wo, const MisSums& 
   if (light.corr && camera.corr && rules.correlated()) {
     // The merged vertex is the camera side's last and the light side's last.
     const float cam = camera.corr->own_total, lig = light.corr->own_total;
-    t.merge = rules.correlated_merges(*light.corr, false, 0.f, rules.mis(fwd),
-                                      rules.reverse_acceptance(*light.corr, fwd), cam) +
-              rules.correlated_merges(*camera.corr, true, 0.f, rules.mis(rev),
-                                      rules.reverse_acceptance(*camera.corr, rev), lig);
+    t.merge = rules.correlated_beyond(*light.corr, false, 1.f, fwd, false, cam) +
+              rules.correlated_beyond(*camera.corr, true, 1.f, rev, false, lig);
     t.own_factor = rules.mis(rules.correlation(cam, lig));
   }
   return t;

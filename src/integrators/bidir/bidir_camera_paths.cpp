@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include "integrators/bidir/bidir_core.h"
 #include "integrators/bidir/subpath_records.h"
@@ -87,14 +88,16 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   if (!(pdf_camera > 0)) return;
   const MisRules& rules = *acc.rules;
   MisSums mis = rules.camera_start(pdf_camera);
-  // Correlation-aware MIS: the subpath's merges one by one, for `mis` and for the sums at the
-  // current hit (mis.h, CorrelationTrack).
-  std::optional<OwnedCorrelationTrack> track, track_at_hit;
+  // Correlation-aware MIS: the subpath's merges one by one, for `mis` (track) and for the sums
+  // at the current hit (track_at_hit); the two swap roles when a hit becomes the vertex (mis.h,
+  // CorrelationTrack).
+  std::optional<OwnedCorrelationTrack> tracks[2];
+  CorrelationTrack *track = nullptr, *track_at_hit = nullptr;
   if (rules.correlated()) {
-    track.emplace();
-    track_at_hit.emplace();
+    track = &tracks[0].emplace();
+    track_at_hit = &tracks[1].emplace();
     rules.correlation_camera_start(*track, pdf_camera);
-    mis.corr = &*track;
+    mis.corr = track;
   }
   const int max_depth = settings_.max_depth;
   const uint64_t light_path = it.light_path_of.light_path(pixel);
@@ -152,7 +155,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     MisSums at_hit = mis;
     if (track) {
       track_at_hit->assign(*track);
-      at_hit.corr = &*track_at_hit;
+      at_hit.corr = track_at_hit;
     }
     rules.hit(at_hit, segment * segment, geometric_cos(si, si.wo));
 
@@ -166,11 +169,8 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
       continue;
     }
     ++depth;
-    mis = at_hit;
-    if (track) {
-      track->assign(*track_at_hit);
-      mis.corr = &*track;
-    }
+    mis = at_hit;  // with corr = track_at_hit, which becomes the track
+    std::swap(track, track_at_hit);
     segment = 0;
     if (depth > max_depth) break;
 

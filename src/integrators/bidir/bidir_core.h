@@ -229,7 +229,10 @@ class BidirIntegrator final : public CameraPathIntegrator {
     return settings_.bidir.correlation_aware && algorithm_ == BidirAlgorithm::Vcm &&
            settings_.max_depth <= CorrelationTrack::kMaxEntries;
   }
-  // The track stored with light vertex `index` (correlation-aware MIS).
+  // A light vertex's track as stored (its entries beyond StoredTrack::kInline appended to the
+  // pool), and the track stored with light vertex `index` (correlation-aware MIS).
+  static StoredTrack store_track(const CorrelationTrack& track,
+                                 std::vector<CorrelationEntry>& pool);
   void load_track(uint32_t index, CorrelationTrack* out) const;
 
   // Scalar pixel means of the film's completed iterations (empty before the first); between

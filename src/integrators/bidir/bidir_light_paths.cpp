@@ -144,6 +144,22 @@ void BidirIntegrator::append_chunk(const Iteration& it, const LightChunk& chunk)
   }
 }
 
+StoredTrack BidirIntegrator::store_track(const CorrelationTrack& track,
+                                         std::vector<CorrelationEntry>& pool) {
+  StoredTrack t;
+  t.own_total = track.own_total;
+  t.seg_cos = track.seg_cos;
+  t.seg_dist2 = track.seg_dist2;
+  t.count = uint32_t(track.count);
+  if (t.count > StoredTrack::kInline) {
+    t.first = uint32_t(pool.size());
+    pool.insert(pool.end(), track.entries, track.entries + track.count);
+  } else {
+    std::copy_n(track.entries, t.count, t.inline_entries);
+  }
+  return t;
+}
+
 void BidirIntegrator::load_track(uint32_t index, CorrelationTrack* out) const {
   const StoredTrack& t = tracks_[index];
   out->count = int(t.count);
@@ -219,21 +235,7 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
       if (stores_vertices()) {
         chunk.vertices.push_back(
             pack_light_vertex({si.p, si.wo, scene.primitive_index(si), depth, beta, mis}));
-        if (track) {
-          StoredTrack t;
-          t.own_total = track->own_total;
-          t.seg_cos = track->seg_cos;
-          t.seg_dist2 = track->seg_dist2;
-          t.count = uint32_t(track->count);
-          if (t.count > StoredTrack::kInline) {
-            t.first = uint32_t(chunk.track_entries.size());
-            chunk.track_entries.insert(chunk.track_entries.end(), track->entries,
-                                       track->entries + track->count);
-          } else {
-            std::copy_n(track->entries, t.count, t.inline_entries);
-          }
-          chunk.tracks.push_back(t);
-        }
+        if (track) chunk.tracks.push_back(store_track(*track, chunk.track_entries));
       }
       if (tech_.light_to_camera) {
         const Rgb c = connect_to_camera(scene, it, si, bsdf, guided_mis() ? guides : kUnguided,

@@ -58,7 +58,7 @@ struct MisCounts {
 };
 
 // Correlation-aware MIS (Grittmann, Georgiev and Slusallek 2021, "Correlation-Aware Multiple
-// Importance Sampling for Bidirectional Rendering Algorithms"; vcm --correlation-aware-mis).
+// Importance Sampling for Bidirectional Rendering Algorithms"; vcm --merge-mis correlation-aware).
 // The merges of an iteration share its N light subpaths, so a merge at vertex x_i of a path is
 // worth fewer than the N pi r^2 independent samples the balance heuristic counts it as. Its
 // count is multiplied by c_i = cam_i / (cam_i + light_i - cam_i light_i), at least 1 / N, where

@@ -26,13 +26,15 @@ constexpr double kMoment = 2.0;  // of every candidate's estimate; its mean is 1
 constexpr double kTruth = (kMoment - 1.0) / (1.0 + 0.01);
 
 // One synthetic probe (synthetic_choice's) recorded into `plan`; returns its work, to finish it.
-ProbeWork record_synthetic_probe(AdaptivePlan& plan, std::mt19937& rng) {
+// pt_scale: path tracing's second moments times this (1: every candidate alike).
+ProbeWork record_synthetic_probe(AdaptivePlan& plan, std::mt19937& rng, float pt_scale = 1.f) {
   const size_t pixels = size_t(kWidth) * kHeight;
   std::exponential_distribution<float> moment(float(1.0 / kMoment));
   plan.begin_probe(0.1f);
   for (size_t p = 0; p < pixels; ++p) {
     AdaptivePlan::CandidateSums sums;  // r = s0 = s1 = 0: the moment is d
     for (float& d : sums.d) d = moment(rng);
+    sums.d[0] *= pt_scale;
     sums.estimate = 1.f;  // the probe's own estimate: the mean (the square the moment loses)
     plan.pixel_end(p, sums);
   }
@@ -49,13 +51,17 @@ ProbeWork record_synthetic_probe(AdaptivePlan& plan, std::mt19937& rng) {
 // path per pixel, no connections or merge queries (so that merging costs nothing extra and the
 // core and the core with merging tie), and photon mapping ten times as dear (left out of the
 // per-pixel mix).
-nlohmann::json synthetic_choice(int probes, uint32_t seed) {
+// price_all: cross-fit every candidate (AdaptivePlan::price_every_candidate); pt_scale: as
+// record_synthetic_probe's.
+nlohmann::json synthetic_choice(int probes, uint32_t seed, bool price_all = true,
+                                float pt_scale = 1.f) {
   AdaptivePlan plan(kWidth, kHeight, /*measured_costs=*/false, /*probe_every_iteration=*/false,
                     /*probe_stride=*/1);
+  plan.price_every_candidate(price_all);
   const std::vector<float> means(size_t(kWidth) * kHeight, 1.f);
   std::mt19937 rng(seed);
   for (int probe = 0; probe < probes; ++probe) {
-    const ProbeWork w = record_synthetic_probe(plan, rng);
+    const ProbeWork w = record_synthetic_probe(plan, rng, pt_scale);
     plan.finish_probe(w, probe == 0 ? std::vector<float>{} : means);
   }
   nlohmann::json stats;
@@ -94,6 +100,44 @@ TEST(AdaptiveChoice, TheMixIsPricedOnProbesThatDidNotChooseIt) {
     }
     // (light paths, connections) pairs, each without and with merging
     EXPECT_EQ(rows, int(AdaptivePlan::kCoreCandidates - 1) / 2) << probes;
+  }
+}
+
+// Cross-fitting only raises a mix's price, so a candidate that loses to the best so far at its
+// in-sample price is not cross-fitted: the choice and every cross-fitted row are those of pricing
+// every candidate, the other rows say null, and their score is the lower bound. Path tracing's
+// moments are ten times the others' here, so that a light-path candidate wins.
+TEST(AdaptiveChoice, CandidatesThatCannotWinAreNotCrossFitted) {
+  for (int probes : {2, 4}) {
+    const nlohmann::json all = synthetic_choice(probes, 3 + uint32_t(probes), true, 10.f);
+    const nlohmann::json lazy = synthetic_choice(probes, 3 + uint32_t(probes), false, 10.f);
+    EXPECT_GT(all["light_path_factor"].get<double>(), 0) << probes;
+    for (const char* key : {"light_path_factor", "connections", "variant", "merge_fraction",
+                            "path_trace_fraction", "stop_fraction"})
+      EXPECT_EQ(all[key], lazy[key]) << key << ", " << probes << " probes";
+    ASSERT_EQ(all["candidates"].size(), lazy["candidates"].size());
+    int skipped = 0, crossed = 0;
+    for (size_t i = 0; i < all["candidates"].size(); ++i) {
+      const nlohmann::json& a = all["candidates"][i];
+      const nlohmann::json& b = lazy["candidates"][i];
+      if (a["light_path_factor"].get<double>() == 0) continue;  // path tracing: no mix
+      ASSERT_FALSE(a["relative_variance_cross_fitted"].is_null());
+      if (b["relative_variance_cross_fitted"].is_null()) {
+        ++skipped;
+        EXPECT_TRUE(b["relative_variance_mixed_halves"].is_null());
+        EXPECT_EQ(b["relative_variance_mixed"], b["relative_variance_mixed_in_sample"]);
+        EXPECT_LE(b["score_mixed"].get<double>(), a["score_mixed"].get<double>());
+        EXPECT_EQ(b["relative_variance_mixed_in_sample"], a["relative_variance_mixed_in_sample"]);
+      } else {
+        ++crossed;
+        EXPECT_EQ(a, b);
+      }
+    }
+    std::printf("[ adaptive ] %d probes: %d of %d mixes cross-fitted\n", probes, crossed,
+                crossed + skipped);
+    // The light-path candidates here differ only in cost: the dearer ones are left out.
+    EXPECT_GT(skipped, 0) << probes;
+    EXPECT_GT(crossed, 0) << probes;
   }
 }
 

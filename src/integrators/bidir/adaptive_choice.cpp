@@ -30,7 +30,7 @@ constexpr double kShrinkSigmas = 2.0;
 constexpr double kPathTracingMargin = 1.05;
 // A candidate renders every pixel in one mode instead of its per-pixel mix only where that is
 // predicted better by more than this factor: the mix is priced with the modes that half of the
-// probes chose (cross-fitted, variant_scores), worse than those that all of them choose, so the
+// probes chose (cross_fit), worse than those that all of them choose, so the
 // price is high by that. On cornell-glass at 48 x 48 the mix (4% of the pixels merging at the
 // caustic) and the core everywhere were priced within 0.1% of each other.
 constexpr double kMixMargin = 1.05;
@@ -135,9 +135,11 @@ size_t pick_variant(const std::array<Score, kVariants>& scores, int force_mode) 
 
 // How a candidate's per-pixel mix is priced: its modes chosen and priced on every probe
 // (in_sample), each half's modes priced on that half (halves) and on the other half
-// (cross_fitted), and the estimate scored.
+// (cross_fitted), and the estimate scored. crossed: halves and cross_fitted were computed (with
+// fewer than two probes they are in_sample; for a candidate that could not win, not priced).
 struct MixPrice {
   double in_sample = 0, halves = 0, cross_fitted = 0, estimate = 0;
+  bool crossed = false;
 };
 
 // A row of the report's candidate table (history[].candidates): what the candidate would render
@@ -146,43 +148,61 @@ nlohmann::json candidate_row(const AdaptivePlan::Candidate& c, const PixelChoice
                              const PixelChoice& mixed, const ModePrices& price, bool stops,
                              double pixels, double roulette, double roulette_merge,
                              const std::array<Score, kVariants>& scores, size_t variant,
-                             const MixPrice& mix) {
+                             const MixPrice& mix, bool cross) {
   const auto score_of = [&](size_t v) {
     return std::isfinite(scores[v].value) ? scores[v].value : -1.0;
   };
-  return {{"light_path_factor", c.light_path_factor},
-          {"connections", c.connections},
-          {"merge_fraction", fraction_of(choice.modes, PixelMode::Merge)},
-          {"path_trace_fraction", fraction_of(choice.modes, PixelMode::PathTrace)},
-          {"relative_variance", choice.variance / pixels},
-          {"relative_variance_no_merge", mixed.variance_no_merge / pixels},
-          {"relative_variance_all_merge", mixed.variance_all_merge / pixels},
-          {"stop_fraction", fraction_of(choice.modes, PixelMode::Stop)},
-          {"relative_variance_all_stop", stops ? mixed.variance_all_stop / pixels : -1.0},
-          {"cost_us_per_pixel_stop", price.stopped},
-          {"cost_us_per_pixel", choice.cost / pixels},
-          {"pixels_missing_energy", choice.missing},
-          {"roulette_factor", roulette},
-          {"roulette_factor_merge", roulette_merge},
-          {"relative_variance_mixed", mix.estimate / pixels},
-          {"relative_variance_mixed_in_sample", mix.in_sample / pixels},
-          {"relative_variance_mixed_halves", mix.halves / pixels},
-          {"relative_variance_cross_fitted", mix.cross_fitted / pixels},
-          {"cost_us_per_pixel_mixed", mixed.cost / pixels},
-          {"variant", kVariantNames[variant]},
-          {"score_mixed", score_of(kMixed)},
-          {"score_all_core", score_of(kAllCore)},
-          {"score_all_merge", score_of(kAllMerge)},
-          {"score_all_stop", score_of(kAllStop)},
-          {"score", scores[variant].value}};
+  const bool not_priced = cross && !mix.crossed;
+  const nlohmann::json null(nullptr);
+  return {
+      {"light_path_factor", c.light_path_factor},
+      {"connections", c.connections},
+      {"merge_fraction", fraction_of(choice.modes, PixelMode::Merge)},
+      {"path_trace_fraction", fraction_of(choice.modes, PixelMode::PathTrace)},
+      {"relative_variance", choice.variance / pixels},
+      {"relative_variance_no_merge", mixed.variance_no_merge / pixels},
+      {"relative_variance_all_merge", mixed.variance_all_merge / pixels},
+      {"stop_fraction", fraction_of(choice.modes, PixelMode::Stop)},
+      {"relative_variance_all_stop", stops ? mixed.variance_all_stop / pixels : -1.0},
+      {"cost_us_per_pixel_stop", price.stopped},
+      {"cost_us_per_pixel", choice.cost / pixels},
+      {"pixels_missing_energy", choice.missing},
+      {"roulette_factor", roulette},
+      {"roulette_factor_merge", roulette_merge},
+      {"relative_variance_mixed", mix.estimate / pixels},
+      {"relative_variance_mixed_in_sample", mix.in_sample / pixels},
+      {"relative_variance_mixed_halves", not_priced ? null : nlohmann::json(mix.halves / pixels)},
+      {"relative_variance_cross_fitted",
+       not_priced ? null : nlohmann::json(mix.cross_fitted / pixels)},
+      {"cost_us_per_pixel_mixed", mixed.cost / pixels},
+      {"variant", kVariantNames[variant]},
+      {"score_mixed", score_of(kMixed)},
+      {"score_all_core", score_of(kAllCore)},
+      {"score_all_merge", score_of(kAllMerge)},
+      {"score_all_stop", score_of(kAllStop)},
+      {"score", scores[variant].value}};
 }
 
 // A candidate's options scored (relative variance x time; the pixels where each misses energy)
-// from v: every probe's variances, then the even and the odd probes' (when cross). mixed: its
-// per-pixel mix from every probe.
-std::array<Score, kVariants> variant_scores(size_t n, const std::array<PairVariances, 3>& v,
-                                            const PixelChoice& mixed, const ModePrices& price,
-                                            bool cross, bool path_tracing, MixPrice& mix) {
+// from every probe's variances v: every pixel in one mode, and its per-pixel mix `mixed` at its
+// in-sample price, which cross_fit can only raise.
+std::array<Score, kVariants> variant_scores(const PairVariances& v, const PixelChoice& mixed,
+                                            const ModePrices& price, bool path_tracing) {
+  std::array<Score, kVariants> scores{};
+  scores[kMixed] = {mixed.missing, mixed.variance * mixed.cost};
+  if (path_tracing) return scores;  // every pixel path traces: no other option
+  for (size_t k = kAllCore; k < kVariants; ++k) {
+    if (!v.of(kVariantModes[k])) continue;
+    const PixelChoice all = uniform_sums(v, k, price);
+    scores[k] = {all.missing, all.variance * all.cost};
+  }
+  return scores;
+}
+
+// The per-pixel mix `mixed` (chosen on every probe) priced from the even and the odd probes'
+// variances (v[1], v[2]).
+MixPrice cross_fit(size_t n, const std::array<PairVariances, 3>& v, const PixelChoice& mixed,
+                   const ModePrices& price) {
   // The per-pixel minimum over noisy estimates is biased low by their noise, and the modes it
   // picks are priced by the same noise: door-ajar at 640 x 480 predicted 7.3 for its mix against
   // 24.7 for photon mapping everywhere, and rendered 2.8x worse than the latter. So the mix is
@@ -193,31 +213,23 @@ std::array<Score, kVariants> variant_scores(size_t n, const std::array<PairVaria
   // square root of the probes, so the whole's mix is priced at its own estimate plus that
   // excess / sqrt(2). (Pricing every option from the halves instead made the choice between
   // candidates as noisy as one probe: point-room and sun-glass at 640 x 480 rendered 8-33% worse.)
-  mix.in_sample = mix.halves = mix.cross_fitted = mix.estimate = mixed.variance;
-  if (cross && !path_tracing) {
-    const auto priced = [&](const std::vector<PixelMode>& modes, const PairVariances& other) {
-      return finite_sum(n, [&](size_t p) {
-        const double x = (*other.of(modes[p]))[p];
-        return std::isfinite(x) ? x : mixed.variances[p];
-      });
-    };
-    const PixelChoice even =
-        choose_modes(v[1].no_merge, v[1].merge, *v[1].pt, v[1].stops, price, false);
-    const PixelChoice odd =
-        choose_modes(v[2].no_merge, v[2].merge, *v[2].pt, v[2].stops, price, false);
-    mix.halves = 0.5 * (even.variance + odd.variance);
-    mix.cross_fitted = 0.5 * (priced(even.modes, v[2]) + priced(odd.modes, v[1]));
-    mix.estimate += std::max(0.0, mix.cross_fitted - mix.halves) / std::sqrt(2.0);
-  }
-  std::array<Score, kVariants> scores{};
-  scores[kMixed] = {mixed.missing, mix.estimate * mixed.cost};
-  if (path_tracing) return scores;  // every pixel path traces: no other option
-  for (size_t k = kAllCore; k < kVariants; ++k) {
-    if (!v[0].of(kVariantModes[k])) continue;
-    const PixelChoice all = uniform_sums(v[0], k, price);
-    scores[k] = {all.missing, all.variance * all.cost};
-  }
-  return scores;
+  MixPrice mix;
+  mix.in_sample = mix.estimate = mixed.variance;
+  const auto priced = [&](const std::vector<PixelMode>& modes, const PairVariances& other) {
+    return finite_sum(n, [&](size_t p) {
+      const double x = (*other.of(modes[p]))[p];
+      return std::isfinite(x) ? x : mixed.variances[p];
+    });
+  };
+  const PixelChoice even =
+      choose_modes(v[1].no_merge, v[1].merge, *v[1].pt, v[1].stops, price, false);
+  const PixelChoice odd =
+      choose_modes(v[2].no_merge, v[2].merge, *v[2].pt, v[2].stops, price, false);
+  mix.halves = 0.5 * (even.variance + odd.variance);
+  mix.cross_fitted = 0.5 * (priced(even.modes, v[2]) + priced(odd.modes, v[1]));
+  mix.estimate += std::max(0.0, mix.cross_fitted - mix.halves) / std::sqrt(2.0);
+  mix.crossed = true;
+  return mix;
 }
 }  // namespace
 
@@ -251,16 +263,16 @@ inline double AdaptivePlan::relative_variance(size_t p, size_t j, double square,
   return (moment - square) / denominator_[p] * roulette_[j];
 }
 
-void AdaptivePlan::relative_variance_rows(size_t first, size_t count, size_t sets,
+void AdaptivePlan::relative_variance_rows(size_t first, size_t count, size_t h_begin, size_t h_end,
                                           const std::vector<float>& means,
                                           const std::array<std::vector<double>, 3>& squares,
                                           Rows& out) const {
   constexpr std::array<Half, 3> halves{Half::All, Half::Even, Half::Odd};
-  for (size_t h = 0; h < sets; ++h)
+  for (size_t h = h_begin; h < h_end; ++h)
     for (size_t k = 0; k < count; ++k) out[h][k].resize(grid_pixels_);
   for_pixel_blocks(grid_pixels_, [&](size_t, size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)
-      for (size_t h = 0; h < sets; ++h)
+      for (size_t h = h_begin; h < h_end; ++h)
         for (size_t k = 0, j = first; k < count; ++k, ++j)
           out[h][k][p] = relative_variance(
               p, j, j == 0 ? square(p, 0, means, halves[h]) : squares[h][p], halves[h]);
@@ -403,7 +415,7 @@ void AdaptivePlan::update_roulette_factors(const std::vector<float>& means,
   tbb::parallel_for(size_t(0), (kCandidates + kRowCandidates - 1) / kRowCandidates, [&](size_t c) {
     const size_t first = c * kRowCandidates, count = std::min(kRowCandidates, kCandidates - first);
     Rows rows;
-    relative_variance_rows(first, count, 1, means, all_squares, rows);
+    relative_variance_rows(first, count, 0, 1, means, all_squares, rows);
     for (size_t k = 0; k < count; ++k) roulette_of(first + k, rows[0][k]);
   });
 }
@@ -434,13 +446,13 @@ std::vector<double> AdaptivePlan::shared_firefly_correction(
   return shared;
 }
 
-void AdaptivePlan::relative_variances(size_t first, size_t count, size_t sets,
+void AdaptivePlan::relative_variances(size_t first, size_t count, size_t h_begin, size_t h_end,
                                       const std::vector<float>& means,
                                       const std::array<std::vector<double>, 3>& squares,
                                       const std::array<std::vector<double>, 3>& correction,
                                       const std::vector<double>& unseen, Rows& out) const {
-  relative_variance_rows(first, count, sets, means, squares, out);
-  for (size_t h = 0; h < sets; ++h)
+  relative_variance_rows(first, count, h_begin, h_end, means, squares, out);
+  for (size_t h = h_begin; h < h_end; ++h)
     for (size_t k = 0; k < count; ++k) {
       std::vector<double>& v = out[h][k];
       for (size_t p = 0; p < grid_pixels_; ++p) v[p] += correction[h][p];
@@ -482,14 +494,24 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
   // Path tracing's bias where it misses energy, weighted by the iterations it would render.
   bias_iterations_ = path_tracing_bias_weight(pw, t);
   const std::vector<double> pt_bias = path_tracing_bias(bias_iterations_, &relative_bias_sum_);
-  for (size_t h = 0; h < sets; ++h) {
-    correction[h] = shared_firefly_correction(means, halves[h], squares_of[h]);
-  }
-  relative_variances(0, 1, sets, means, squares_of, correction, unseen, pt);
-  for (size_t h = 0; h < sets; ++h)
-    for (size_t p = 0; p < grid_pixels_; ++p) pt[h][0][p] += pt_bias[p];
-  relative_variances(kCoreCandidates, kStopCandidates, sets, means, squares_of, correction, unseen,
+  correction[0] = shared_firefly_correction(means, Half::All, squares_of[0]);
+  relative_variances(0, 1, 0, 1, means, squares_of, correction, unseen, pt);
+  relative_variances(kCoreCandidates, kStopCandidates, 0, 1, means, squares_of, correction, unseen,
                      stop);
+  // The halves' path tracing and photon mapping, when the first candidate needs them.
+  bool halves_ready = false;
+  const auto prepare_halves = [&] {
+    if (halves_ready) return;
+    halves_ready = true;
+    for (size_t h = 1; h < sets; ++h)
+      correction[h] = shared_firefly_correction(means, halves[h], squares_of[h]);
+    relative_variances(0, 1, 1, sets, means, squares_of, correction, unseen, pt);
+    for (size_t h = 1; h < sets; ++h)
+      for (size_t p = 0; p < grid_pixels_; ++p) pt[h][0][p] += pt_bias[p];
+    relative_variances(kCoreCandidates, kStopCandidates, 1, sets, means, squares_of, correction,
+                       unseen, stop);
+  };
+  for (size_t p = 0; p < grid_pixels_; ++p) pt[0][0][p] += pt_bias[p];
   // Path tracing is the default only among equals (kPathTracingMargin).
   Score best, path_tracing;
   size_t best_j = 0, best_variant = kMixed;
@@ -503,14 +525,19 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
     const size_t si = j == 0 ? kStopCandidates : stop_index_of(c.light_path_factor);
     std::array<PairVariances, 3> v;
     Rows pair;
-    if (j != 0) relative_variances(j, 2, sets, means, squares_of, correction, unseen, pair);
-    for (size_t h = 0; h < sets; ++h) {
-      v[h].pt = &pt[h][0];
-      v[h].stops = si < kStopCandidates ? &stop[h][si] : nullptr;
-      if (j == 0) continue;
-      v[h].no_merge = std::move(pair[h][0]);
-      v[h].merge = std::move(pair[h][1]);
-    }
+    // Every probe's variances first; the halves' only for a candidate that may win (below).
+    const auto take = [&](size_t h_begin, size_t h_end) {
+      if (j != 0)
+        relative_variances(j, 2, h_begin, h_end, means, squares_of, correction, unseen, pair);
+      for (size_t h = h_begin; h < h_end; ++h) {
+        v[h].pt = &pt[h][0];
+        v[h].stops = si < kStopCandidates ? &stop[h][si] : nullptr;
+        if (j == 0) continue;
+        v[h].no_merge = std::move(pair[h][0]);
+        v[h].merge = std::move(pair[h][1]);
+      }
+    };
+    take(0, 1);
     const ModePrices price{base_cost(c, pw, t),
                            j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t),
                            path_tracing_cost(c, pw, t),
@@ -522,13 +549,25 @@ void AdaptivePlan::choose(const std::vector<float>& means) {
         j == 0 ? choose_modes(pt[0][0], pt[0][0], pt[0][0], nullptr, price, true)
                : choose_modes(v[0].no_merge, v[0].merge, pt[0][0], v[0].stops, price, false);
     MixPrice mix;
-    const std::array<Score, kVariants> scores =
-        variant_scores(grid_pixels_, v, choice, price, cross, j == 0, mix);
+    mix.in_sample = mix.halves = mix.cross_fitted = mix.estimate = choice.variance;
+    std::array<Score, kVariants> scores = variant_scores(v[0], choice, price, j == 0);
+    // Cross-fitting can only raise the mix's score, so a candidate none of whose options beats
+    // the best so far at the mix's in-sample price cannot be taken: its halves are not priced
+    // (they were most of a choice's time where one candidate leads by far, as path tracing on
+    // material-testball). The choice is the same.
+    const bool contender =
+        std::any_of(scores.begin(), scores.end(), [&](const Score& x) { return x < best; });
+    if (cross && j != 0 && (contender || price_all_)) {
+      prepare_halves();
+      take(1, sets);
+      mix = cross_fit(grid_pixels_, v, choice, price);
+      scores[kMixed].value = mix.estimate * choice.cost;
+    }
     const size_t variant = pick_variant(scores, j == 0 ? -1 : force_mode_);
     PixelChoice option = variant == kMixed ? choice : uniform_choice(v[0], variant, price);
     table.push_back(candidate_row(c, option, choice, price, v[0].stops != nullptr, pixels,
-                                  roulette_[j], roulette_[j == 0 ? j : j + 1], scores, variant,
-                                  mix));
+                                  roulette_[j], roulette_[j == 0 ? j : j + 1], scores, variant, mix,
+                                  cross && j != 0));
     // A forced mode other than path tracing needs light paths (force_mode_).
     const bool excluded = j == 0 && force_mode_ >= 0 && force_mode_ != int(PixelMode::PathTrace);
     if (scores[variant] < best && !excluded) {

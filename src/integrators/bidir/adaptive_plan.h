@@ -151,6 +151,10 @@ class AdaptivePlan {
   // force_mode >= 0: every pixel takes that PixelMode after each choice (experiments, tests).
   AdaptivePlan(int width, int height, bool measured_costs, bool probe_every_iteration = false,
                int probe_stride = 0, int force_mode = -1);
+  // Cross-fits every candidate's per-pixel mix (choose()), also those that cannot win at the
+  // mix's in-sample price, which only lowers it: tests of the cross-fitting. The choice is the
+  // same either way; the report then gives every candidate's halves (otherwise null there).
+  void price_every_candidate(bool on) { price_all_ = on; }
   // A probe renders its configuration (two connections per camera vertex, merging) and records
   // every contribution; both cost about twice what a chosen iteration costs, and on a large
   // image a probe is long beside the render (door-ajar at 640 x 480, 20 s, before this bound: 4
@@ -323,16 +327,17 @@ class AdaptivePlan {
   static constexpr size_t kRowCandidates = kStopCandidates;
   using Rows = std::array<std::array<std::vector<double>, kRowCandidates>, 3>;
   // out[h][k][p]: relative_variance of candidate first + k at grid pixel p under the h-th half,
-  // for h < sets (squares[h]: squares(means, that half)). In one pass over the pixels, whose
-  // moments lie side by side per pixel: a pass per candidate and half read each pixel's cache
+  // for h in [h_begin, h_end) (squares[h]: squares(means, that half)). In one pass over the pixels,
+  // whose moments lie side by side per pixel: a pass per candidate and half read each pixel's cache
   // line of the moments again (on material-testball, 384 x 216, the largest part of a choice's
   // time: `relative_variance` 12.8% of a two-probe render, whose choice was about 30%).
-  void relative_variance_rows(size_t first, size_t count, size_t sets,
+  void relative_variance_rows(size_t first, size_t count, size_t h_begin, size_t h_end,
                               const std::vector<float>& means,
                               const std::array<std::vector<double>, 3>& squares, Rows& out) const;
   // The same, plus correction[h] (shared_firefly_correction), pooled over neighbours and
   // clamped at 0, plus `unseen` (unseen_variance; empty: none).
-  void relative_variances(size_t first, size_t count, size_t sets, const std::vector<float>& means,
+  void relative_variances(size_t first, size_t count, size_t h_begin, size_t h_end,
+                          const std::vector<float>& means,
                           const std::array<std::vector<double>, 3>& squares,
                           const std::array<std::vector<double>, 3>& correction,
                           const std::vector<double>& unseen, Rows& out) const;
@@ -385,6 +390,7 @@ class AdaptivePlan {
   bool measured_ = false;
   bool probe_all_ = false;
   int force_mode_ = -1;
+  bool price_all_ = false;  // price_every_candidate
   // pixels x candidates: the sum over probes of the second-moment estimates, as float24 (3 bytes
   // each, core/compact_float.h). 2^-16 relative rounding per addition: thousands of additions
   // (every probe, every light-tracing splat) stay far below the probes' sampling noise, and far

@@ -343,6 +343,8 @@ class AdaptivePlan {
                           const std::vector<double>& unseen, Rows& out) const;
   // Scores every candidate from the probes so far and takes the best (adaptive_choice.cpp).
   void choose(const std::vector<float>& means);
+  // What one choice's candidates share, and the scoring of each (adaptive_choice.cpp).
+  struct ChoiceInputs;
   // Adds the choice just taken to the history: its option (variant), costs and candidate table.
   void record_choice(const char* variant, const CostModel& t, nlohmann::json table);
   // Takes candidate j with one mode per grid pixel (chosen_, modes_, chosen_j_).

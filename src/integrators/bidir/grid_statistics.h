@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -32,6 +33,23 @@ template <typename Fn>
 void for_pixel_blocks(size_t n, Fn&& fn) {
   tbb::parallel_for(size_t(0), (n + kPixelBlock - 1) / kPixelBlock,
                     [&](size_t b) { fn(b, b * kPixelBlock, std::min(n, (b + 1) * kPixelBlock)); });
+}
+
+// The sum over [0, n) of the finite values of value(p), the same for any thread count.
+template <typename Fn>
+double finite_sum(size_t n, Fn&& value) {
+  std::vector<double> blocks((n + kPixelBlock - 1) / kPixelBlock);
+  for_pixel_blocks(n, [&](size_t b, size_t begin, size_t end) {
+    double sum = 0;
+    for (size_t p = begin; p < end; ++p) {
+      const double x = value(p);
+      if (std::isfinite(x)) sum += x;
+    }
+    blocks[b] = sum;
+  });
+  double total = 0;
+  for (double x : blocks) total += x;
+  return total;
 }
 
 }  // namespace caustica::bidir

@@ -208,6 +208,7 @@ MixPrice cross_fit(size_t n, const std::array<PairVariances, 3>& v, const PixelC
   mix.crossed = true;
   return mix;
 }
+
 // One candidate scored: the option it would render (variant: its per-pixel mix or one mode
 // everywhere), that option's score, its per-pixel mix, and its row of the report.
 struct ScoredCandidate {
@@ -269,10 +270,14 @@ struct AdaptivePlan::ChoiceInputs {
       correction[h] = plan.shared_firefly_correction(means, kHalves[h], squares[h]);
     variances_of_every_set(1, sets);
   }
+  // Candidate j's photon-mapping candidate (kStopCandidates: none; path tracing has none).
+  static size_t stop_of(size_t j) {
+    return j == 0 ? kStopCandidates : stop_index_of(candidates()[j].light_path_factor);
+  }
   // Candidate j's variances (its pair's, path tracing's, its photon mapping's) under the sets
   // [h_begin, h_end) into v.
   void variances(size_t j, size_t h_begin, size_t h_end, std::array<PairVariances, 3>& v) const {
-    const size_t si = j == 0 ? kStopCandidates : stop_index_of(candidates()[j].light_path_factor);
+    const size_t si = stop_of(j);
     Rows pair;
     if (j != 0)
       plan.relative_variances(j, 2, h_begin, h_end, means, squares, correction, unseen, pair);
@@ -289,7 +294,7 @@ struct AdaptivePlan::ChoiceInputs {
   ModePrices prices(size_t j, const PairVariances& v) const {
     const std::vector<Candidate>& list = candidates();
     const Candidate& c = list[j];
-    const size_t si = j == 0 ? kStopCandidates : stop_index_of(c.light_path_factor);
+    const size_t si = stop_of(j);
     return {base_cost(c, pw, t),
             j == 0 ? 0.0 : merge_cost(list[j + 1], pw, t),
             path_tracing_cost(c, pw, t),

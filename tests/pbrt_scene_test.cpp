@@ -161,6 +161,59 @@ TEST(PbrtShapes, DiskNormalIsPlusZ) {
   EXPECT_GT(si.ng.z, 0.99f);
 }
 
+// pbrt-v4's cylinder: radius, zmin, zmax, phimax about the z axis; the normal points away
+// from the axis (cross(dp/du, dp/dv)), uv = (phi / phimax, (z - zmin) / (zmax - zmin)).
+TEST(PbrtShapes, CylinderIsPbrtV4s) {
+  test::captured_warnings().clear();
+  auto scene = load_text(
+      with_camera("Shape \"cylinder\" \"float radius\" 2 \"float zmin\" 3 \"float zmax\" -1\n"));
+  EXPECT_TRUE(test::captured_warnings().empty());
+  const SurfaceInteraction side = hit(*scene, {9, 0, 2}, {-1, 0, 0});
+  EXPECT_NEAR(side.p.x, 2, 1e-4f);
+  EXPECT_GT(side.ng.x, 0.999f);
+  EXPECT_GT(side.shading.n.x, 0.99999f);
+  EXPECT_NEAR(side.uv.x, 0, 1e-4f);
+  EXPECT_NEAR(side.uv.y, 0.75f, 1e-4f);
+  // A quarter turn: u = 1/4; the shading normal is radial between the tessellation's edges.
+  const float c = std::cos(0.3f), s = std::sin(0.3f);
+  const SurfaceInteraction turned = hit(*scene, {9 * c, 9 * s, 0}, {-c, -s, 0});
+  EXPECT_NEAR(turned.uv.x, 0.3f / (2 * kPi), 1e-4f);
+  EXPECT_NEAR(turned.shading.n.x, c, 1e-4f);
+  EXPECT_NEAR(turned.shading.n.y, s, 1e-4f);
+  EXPECT_NEAR(length(turned.p - Vec3(0, 0, turned.p.z)), 2, 1e-3f);
+  // Open at both ends: a ray along the axis hits nothing.
+  SurfaceInteraction none;
+  EXPECT_FALSE(scene->intersect(Ray{{0, 0, 9}, {0, 0, -1}, kInfinity}, &none));
+}
+
+TEST(PbrtShapes, PartialCylinderAndItsOrientation) {
+  const std::string half = "Shape \"cylinder\" \"float phimax\" 180\n";
+  // Through the missing half (y < 0) to the inside of the kept one: the normal faces away.
+  const SurfaceInteraction inside = hit(*load_text(with_camera(half)), {0, -5, 0}, {0, 1, 0});
+  EXPECT_NEAR(inside.p.y, 1, 1e-4f);
+  EXPECT_GT(inside.ng.y, 0.999f);
+  EXPECT_NEAR(inside.uv.x, 0.5f, 1e-4f);
+  const SurfaceInteraction reversed =
+      hit(*load_text(with_camera("ReverseOrientation\n" + half)), {0, -5, 0}, {0, 1, 0});
+  EXPECT_LT(reversed.ng.y, -0.999f);
+  EXPECT_LT(reversed.shading.n.y, -0.999f);
+  // A mirroring transform flips a quadric's normal as pbrt-v4 does (unlike a mesh's winding).
+  const SurfaceInteraction mirrored =
+      hit(*load_text(with_camera("Scale 1 1 -1\n" + half)), {0, -5, 0}, {0, 1, 0});
+  EXPECT_LT(mirrored.ng.y, -0.999f);
+}
+
+TEST(PbrtLights, CylinderAreaLightEmitsOutward) {
+  auto scene =
+      load_text(with_camera("AreaLightSource \"diffuse\" \"rgb L\" [3 3 3]\n"
+                            "Shape \"cylinder\" \"float radius\" 0.5\n"));
+  EXPECT_EQ(scene->lights().size(), scene->triangle_count());  // one emitter per triangle
+  const SurfaceInteraction si = hit(*scene, {0, 5, 0}, {0, -1, 0});
+  ASSERT_NE(si.area_light, nullptr);
+  EXPECT_NEAR(si.area_light->radiance(si.p, si.ng, si.uv, {0, 1, 0}).g, 3, 1e-4f);
+  EXPECT_TRUE(si.area_light->radiance(si.p, si.ng, si.uv, {0, -1, 0}).is_black());
+}
+
 TEST(PbrtShapes, ReverseOrientationFlipsTriangleNormals) {
   const std::string tri = "Shape \"trianglemesh\" \"point3 P\" [-1 -1 0  1 -1 0  0 1 0]\n";
   EXPECT_GT(hit(*load_text(with_camera(tri)), {0, 0, 5}, {0, 0, -1}).ng.z, 0.99f);

@@ -124,6 +124,33 @@ TriangleMesh make_disk(const ParamList& params) {
   return mesh;
 }
 
+// pbrt-v4's cylinder about the z axis: outward normal cross(dp/du, dp/dv) with u along phi
+// and v from zmin to zmax, uv = (phi / phimax, (z - zmin) / (zmax - zmin)). Tessellated
+// around (exact along z) with radial shading normals, as finely as the disk.
+TriangleMesh make_cylinder(const ParamList& params) {
+  const float radius = params.get_float("radius", 1);
+  const float z0 = params.get_float("zmin", -1), z1 = params.get_float("zmax", 1);
+  const float z_min = std::min(z0, z1), z_max = std::max(z0, z1);
+  const float phi_max = radians(clamp(params.get_float("phimax", 360), 0.f, 360.f));
+  TriangleMesh mesh;
+  if (!(phi_max > 0) || !(radius > 0) || !(z_max > z_min)) return mesh;  // empty
+  const int segments = std::max(4, int(std::ceil(256 * phi_max / (2 * kPi))));
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i <= segments; ++i) {
+      const float u = float(i) / float(segments), phi = u * phi_max;
+      const Vec3 n(std::cos(phi), std::sin(phi), 0.f);
+      mesh.positions.emplace_back(radius * n.x, radius * n.y, j == 0 ? z_min : z_max);
+      mesh.normals.push_back(n);
+      mesh.uvs.emplace_back(u, float(j));
+    }
+  const uint32_t row = uint32_t(segments + 1);
+  for (int i = 0; i < segments; ++i) {
+    const uint32_t a = uint32_t(i), b = a + 1, c = b + row, d = a + row;
+    mesh.indices.insert(mesh.indices.end(), {a, b, c, a, c, d});
+  }
+  return mesh;
+}
+
 TriangleMesh make_ply(const ParamList& params, const SourceLocation& where, LoaderContext& ctx) {
   const Param* fp = params.find("filename", {ParamType::String});
   if (!fp) throw SceneLoadError(where, "plymesh: \"string filename\" is required");
@@ -226,8 +253,11 @@ std::optional<ShapeGeometry> make_shape(const std::string& type, const ParamList
     } else {
       g.sphere_radius = radius;
     }
-  } else if (type == "curve" || type == "cylinder" || type == "cone" || type == "paraboloid" ||
-             type == "hyperboloid" || type == "nurbs" || type == "heightfield") {
+  } else if (type == "cylinder") {
+    g.mesh = make_cylinder(params);
+    g.quadric = true;
+  } else if (type == "curve" || type == "cone" || type == "paraboloid" || type == "hyperboloid" ||
+             type == "nurbs" || type == "heightfield") {
     ctx.warnings.warn(where, "shape " + quote_excerpt(type) + " is not supported; skipped",
                       "shape " + type);
     params.mark_all_used();

@@ -1,7 +1,7 @@
 // pbrt-v4 shapes as object-space geometry: "trianglemesh", "plymesh", "bilinearmesh" (two
-// triangles per quad), "disk" (finely tessellated), "sphere" (kept exact when whole;
-// partial spheres are tessellated with a warning), "loopsubdiv" (its control mesh, with a
-// warning). Curves, cylinders and other shapes warn once and are skipped.
+// triangles per quad), "disk" and "cylinder" (finely tessellated), "sphere" (kept exact when
+// whole; partial spheres are tessellated with a warning), "loopsubdiv" (its control mesh, with
+// a warning). Curves and the quadrics pbrt-v4 dropped warn once and are skipped.
 #pragma once
 
 #include <optional>
@@ -16,8 +16,8 @@ namespace caustica::pbrt {
 struct ShapeGeometry {
   std::optional<TriangleMesh> mesh;    // object space
   std::optional<float> sphere_radius;  // a whole sphere at the origin
-  // True for tessellated quadrics (disk, partial sphere): pbrt-v4 computes their normal in
-  // object space and flips it when the transform swaps handedness, unlike triangle meshes.
+  // True for tessellated quadrics (disk, cylinder, partial sphere): pbrt-v4 computes their normal
+  // in object space and flips it when the transform swaps handedness, unlike triangle meshes.
   bool quadric = false;
 };
 

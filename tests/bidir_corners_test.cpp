@@ -393,9 +393,9 @@ TEST(BidirLightSeenDirectly, EmissionPointsConnectedToTheLensConvergeAtOnce) {
 }
 
 // A 1.0 x 0.7 light (about 56 pixels) behind a surface without a material (a pbrt-v4
-// "interface"): camera rays pass it, but the emission points' shadow rays stop there. The camera
-// ray must then keep weight 1 (bidir_camera_paths.cpp, through_interface); weighted against
-// connections that cannot happen (about 91% of the weight here) the light went dark.
+// "interface"): camera rays pass it, and so do the emission points' shadow rays
+// (Scene::shadow_transmittance). When they stopped there, weighting the camera ray against
+// connections that could not happen (about 91% of the weight here) made the light go dark.
 TEST(BidirLightSeenDirectly, ThroughAnInterfaceCameraRaysKeepTheLight) {
   auto scene = light_facing_the_lens(-0.5f, 0.5f, -0.35f, 0.35f, true);
   const double expected = 100.0 * (1.0 * kPixelsPerUnit) * (0.7 * kPixelsPerUnit);

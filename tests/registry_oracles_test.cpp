@@ -11,6 +11,7 @@
 #include "image/metrics.h"
 #include "integrators/registry.h"
 #include "io/builtin_scenes.h"
+#include "pbrt_test_util.h"
 #include "test_scenes.h"
 
 using namespace caustica;
@@ -86,7 +87,8 @@ TEST_P(RegistryOracle, EnvironmentFurnaceIsInvisible) {
       << " se " << st.standard_error;
 }
 
-// Agreement with pt where no path is delta-only (cornell, cornell-glossy), for every integrator
+// Agreement with pt where no path is delta-only (cornell, cornell-glossy, and cornell-absorbing,
+// whose media every subpath, shadow ray, connection and merge crosses), for every integrator
 // whose flags say it samples every such path. The bound is derived from measured noise. With a
 // common normalisation (the pt average as reference, eps 0.01 as rel_mse), d(a, b) = mean of
 // (a - b)^2 / (ref^2 + eps) gives E[d(x1, x2)] = 2 v_x for two independent renders of an unbiased
@@ -103,7 +105,7 @@ TEST_P(RegistryAgreement, AgreesWithPathTracing) {
         sum += sqr(double(a[i][c]) - b[i][c]) / (sqr(double(ref[i][c])) + 0.01);
     return sum / (3.0 * a.pixel_count());
   };
-  for (const char* scene_name : {"cornell", "cornell-glossy"}) {
+  for (const char* scene_name : {"cornell", "cornell-glossy", "cornell-absorbing"}) {
     auto scene = make_builtin_scene(scene_name, 32, 32);
     IntegratorSettings s;
     s.max_depth = 5;
@@ -131,6 +133,26 @@ TEST_P(RegistryAgreement, AgreesWithPathTracing) {
                 scene_name, GetParam().c_str(), diff, expected, rel_mse(x_avg, pt_avg));
     EXPECT_LT(diff, bound) << scene_name;
   }
+}
+
+// Beer-Lambert: the camera at the centre of a ball of absorbing medium of radius 1 (bounded by
+// an interface, the camera inside through MediumInterface before Camera) under a uniform
+// environment of radiance 1 sees exactly exp(-sigma_a) in every pixel and channel.
+TEST_P(RegistryOracle, AbsorbingMediumIsBeerLambert) {
+  auto scene = test::load_text(
+      "MakeNamedMedium \"ink\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.2 1 2.5] "
+      "\"rgb sigma_s\" [0 0 0]\n"
+      "MediumInterface \"\" \"ink\"\n"
+      "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 60\n"
+      "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n"
+      "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n"
+      "AttributeBegin\nMediumInterface \"ink\" \"\"\nMaterial \"interface\"\n"
+      "Shape \"sphere\" \"float radius\" 1\nAttributeEnd\n");
+  ASSERT_TRUE(scene->has_media());
+  const auto r = render_with(*scene, GetParam(), 2);
+  const Rgb expected(std::exp(-0.2f), std::exp(-1.f), std::exp(-2.5f));
+  for (size_t i = 0; i < r.image.pixel_count(); ++i)
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR(r.image[i][c], expected[c], 1e-4f) << "pixel " << i;
 }
 
 // Random streams are keyed by pixel or path and iteration, never by thread.

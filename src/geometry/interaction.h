@@ -5,6 +5,7 @@
 
 #include "core/frame.h"
 #include "core/vec.h"
+#include "geometry/medium.h"
 
 namespace caustica {
 
@@ -28,6 +29,10 @@ struct SurfaceInteraction {
   static constexpr uint32_t kNoInstance = 0xffffffffu;
   const Material* material = nullptr;  // may be null: an interface only (no scattering)
   const Light* area_light = nullptr;   // the emitter of this primitive, if any
+  MediumInterface media;               // the media this primitive separates (medium.h)
+
+  // This end of a segment leaving along w, as far as media go (medium.h).
+  SegmentEnd medium_toward(Vec3 w) const { return segment_end(media, ng, w); }
 
   // Ray origin nudged off the surface along ng, to the side of w (pbrt-v4's OffsetRayOrigin).
   Vec3 offset_origin(Vec3 w) const {

@@ -255,6 +255,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
   float prev_pdf = 0;   // density of the direction that produced `ray` (mixture where guided)
   Vec3 prev_p;
   float prev_nee = 1;  // the probability of next event estimation at prev_p
+  SegmentEnd start;    // the first end of `ray`, for media (the camera's names none)
 
   auto add = [&](Rgb c) {
     L += c;
@@ -269,7 +270,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
   for (;;) {
     SurfaceInteraction si;
     Bsdf bsdf;
-    if (!next_scattering_vertex(scene, ray, arena, &si, &bsdf, add_emission)) break;
+    if (!next_scattering_vertex(scene, ray, start, beta, arena, &si, &bsdf, add_emission)) break;
     if (depth++ == settings_.max_depth) break;
 
     const Vec3 wo = si.wo;
@@ -320,6 +321,7 @@ Rgb GuidedPathTracer::estimate(const Scene& scene, const CameraSample& sample, P
     prev_nee = q;
     specular_bounce = s->specular;
     prev_p = si.p;
+    start = si.medium_toward(s->wi);
     ray = si.spawn_ray(s->wi);
     if (beta.is_black()) break;
     rr_beta *= s->bsdf_weight;

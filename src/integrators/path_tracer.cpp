@@ -18,6 +18,7 @@ Rgb PathTracer::radiance(const Scene& scene, const Ray& camera_ray, Pcg32& rng,
   float eta_scale = 1;  // product of eta^2 across refractions, undone for Russian roulette
   float prev_pdf = 0;   // solid-angle pdf of the BSDF sample that produced `ray`
   Vec3 prev_p;          // where that ray started (for the lights' pdf_li)
+  SegmentEnd start;     // that ray's first end, for media (the camera's names none)
 
   // Emission seen by this ray: full weight after delta bounces, MIS-weighted otherwise.
   auto add_emission = [&](const SurfaceInteraction* hit) {
@@ -28,7 +29,7 @@ Rgb PathTracer::radiance(const Scene& scene, const Ray& camera_ray, Pcg32& rng,
   for (;;) {
     SurfaceInteraction si;
     Bsdf bsdf;
-    if (!next_scattering_vertex(scene, ray, arena, &si, &bsdf, add_emission)) break;
+    if (!next_scattering_vertex(scene, ray, start, beta, arena, &si, &bsdf, add_emission)) break;
     if (depth++ == settings_.max_depth) break;
 
     const Vec3 wo = si.wo;
@@ -49,6 +50,7 @@ Rgb PathTracer::radiance(const Scene& scene, const Ray& camera_ray, Pcg32& rng,
     specular_bounce = bs->is_specular();
     if (bs->is_transmission()) eta_scale *= sqr(bs->eta);
     prev_p = si.p;
+    start = si.medium_toward(bs->wi);
     ray = si.spawn_ray(bs->wi);
     if (beta.is_black()) break;
     if (!survives_russian_roulette(beta, eta_scale, depth, rng)) break;

@@ -87,24 +87,40 @@ std::optional<DirectLightSample> sample_direct_light(const Scene& scene,
                                                      float u_light, Vec2 u);
 
 // Follows `ray` to the next vertex that scatters: through interfaces (no material, or a material
-// with no BSDF there) it goes straight on. on_emission(hit) is called for every surface reached
-// (hit != nullptr) and, with nullptr, when the ray escapes; then it returns false. On true, si
-// and bsdf describe the vertex (bsdf allocated in arena).
+// with no BSDF there) it goes straight on. Each segment's transmittance through absorbing media
+// (geometry/medium.h) is multiplied into beta before the surface it reaches is seen; `start` is
+// the segment's first end (the camera's, {}, or the previous vertex's medium_toward(ray.d)).
+// on_emission(hit) is called for every surface reached (hit != nullptr) and, with nullptr, when
+// the ray escapes; then it returns false. On true, si and bsdf describe the vertex (bsdf
+// allocated in arena).
 template <typename OnEmission>
-bool next_scattering_vertex(const Scene& scene, Ray& ray, ScratchArena& arena,
-                            SurfaceInteraction* si, Bsdf* bsdf, OnEmission&& on_emission) {
+bool next_scattering_vertex(const Scene& scene, Ray& ray, SegmentEnd start, Rgb& beta,
+                            ScratchArena& arena, SurfaceInteraction* si, Bsdf* bsdf,
+                            OnEmission&& on_emission) {
+  const bool media = scene.has_media();
   for (;;) {
     if (!scene.intersect(ray, si)) {
+      if (media) beta *= scene.transmittance(start, {}, kInfinity);
       on_emission(nullptr);
       return false;
     }
+    if (media) beta *= scene.transmittance(start, si->medium_toward(-ray.d), si->t * length(ray.d));
     on_emission(si);
     if (si->material) {
       *bsdf = si->material->bsdf(*si, arena);
       if (bsdf->valid()) return true;
     }
+    start = si->medium_toward(ray.d);
     ray = si->spawn_ray(ray.d);
   }
+}
+
+// With absorbing media: what of the light sample's radiance reaches si through them, 0 where its
+// shadow ray is blocked (Scene::shadow_transmittance, geometry/medium.h).
+inline Rgb light_sample_transmittance(const Scene& scene, const SurfaceInteraction& si,
+                                      const DirectLightSample& d) {
+  return scene.shadow_transmittance(d.shadow, si.medium_toward(d.ls.wi),
+                                    d.light->medium_toward(d.ls.n_light, -d.ls.wi));
 }
 
 // What an unoccluded next event sample saw, for integrators that learn from it (path guiding):
@@ -133,11 +149,15 @@ Rgb direct_light_mis(const Scene& scene, const SurfaceInteraction& si, const Bsd
   if (seen) seen->Li = Rgb(0.f);
   if (bsdf.is_delta() || scene.light_sampler().empty()) return Rgb(0.f);
   const auto d = sample_direct_light(scene, si, bsdf, u_light, u);
-  if (!d || scene.occluded(d->shadow)) return Rgb(0.f);
+  if (!d) return Rgb(0.f);
+  Rgb tr(1.f);
+  if (scene.traces_transmittance() ? (tr = light_sample_transmittance(scene, si, *d)).is_black()
+                                   : scene.occluded(d->shadow))
+    return Rgb(0.f);
   const float light_pdf = probability * (d->pmf * d->ls.pdf_w);
   const float w = d->light->is_delta() ? 1.f : mis(light_pdf, sampling_pdf(d->ls.wi));
-  if (seen) *seen = {d->ls.wi, d->ls.radiance, d->f, light_pdf, w, d->light->is_delta()};
-  return beta * d->f * d->ls.radiance * (w / light_pdf);
+  if (seen) *seen = {d->ls.wi, d->ls.radiance * tr, d->f, light_pdf, w, d->light->is_delta()};
+  return beta * d->f * (d->ls.radiance * tr) * (w / light_pdf);
 }
 
 // The probability q that Russian roulette ends a path after `depth` scattering vertices with

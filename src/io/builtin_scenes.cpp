@@ -119,6 +119,22 @@ std::unique_ptr<Scene> cornell_glossy(int w, int h) {
   return b.build("cornell-glossy");
 }
 
+// Cornell box with absorbing media and no delta paths, so every integrator must converge to the
+// same image: on the left a ball of coloured absorbing medium bounded by an interface (no
+// material, geometry/medium.h), on the right a diffuse ball inside a larger ball of another
+// medium. Light paths, camera paths, shadow rays, connections and merges all cross both.
+std::unique_ptr<Scene> cornell_absorbing(int w, int h) {
+  SceneBuilder b;
+  add_cornell_box(b);
+  const int16_t blue = b.add_medium({Rgb(3.0f, 1.2f, 0.3f)}),
+                amber = b.add_medium({Rgb(0.4f, 1.0f, 2.5f)});
+  b.add_sphere({kLeftSphere, 0.5f}, nullptr, nullptr, {blue, kNoMedium});
+  b.add_sphere({kRightSphere, 0.5f}, nullptr, nullptr, {amber, kNoMedium});
+  b.add_sphere({kRightSphere, 0.3f}, diffuse(Rgb(0.803922f)));
+  finish_cornell(b, w, h);
+  return b.build("cornell-absorbing");
+}
+
 // A Cornell box whose floor is covered by a displaced height field of about a million
 // triangles, with the glass sphere resting on it: enough geometry that BVH traversal, not
 // shading, dominates a ray's cost (`caustica bench`). Deterministic: the heights are a fixed sum
@@ -193,6 +209,9 @@ std::vector<BuiltinSceneInfo> builtin_scenes() {
        "the default: Cornell box with a mirror and a glass sphere (= cornell-caustics.pbrt)"},
       {"cornell", "Cornell box, diffuse only, area light"},
       {"cornell-glossy", "Cornell box with two rough metal spheres (no delta paths)"},
+      {"cornell-absorbing",
+       "Cornell box with two balls of absorbing medium, one around a diffuse ball (no delta "
+       "paths)"},
       {"furnace",
        "camera inside a closed diffuse sphere, albedo 0.5, emitting 1: radiance is exactly 2"},
       {"many-triangles", "Cornell box, floor a 1,002,528-triangle height field, glass sphere"},
@@ -205,6 +224,7 @@ std::unique_ptr<Scene> make_builtin_scene(const std::string& name, int w, int h)
   if (name == "cornell-glass") return cornell_glass(w, h);
   if (name == "cornell") return cornell(w, h);
   if (name == "cornell-glossy") return cornell_glossy(w, h);
+  if (name == "cornell-absorbing") return cornell_absorbing(w, h);
   if (name == "furnace") return make_furnace_scene(FurnaceParams{}, w > 0 ? w : 32, h > 0 ? h : 32);
   if (name == "env-furnace") return env_furnace(w, h);
   if (name == "many-triangles") return many_triangles(w, h);

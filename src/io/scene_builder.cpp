@@ -22,7 +22,8 @@ void check_mesh(const TriangleMesh& mesh) {
 }
 }  // namespace
 
-void SceneBuilder::add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaEmission* emission) {
+void SceneBuilder::add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaEmission* emission,
+                            MediumInterface media) {
   check_mesh(mesh);
   SceneData::MeshEntry entry;
   if (emission && !emission->radiance.is_black()) {
@@ -30,24 +31,28 @@ void SceneBuilder::add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaE
     for (size_t t = 0; t < mesh.triangle_count(); ++t) {
       data_.lights.push_back(
           make_triangle_area_light(mesh, t, emission->radiance, emission->two_sided));
+      data_.lights.back()->media = media;
       check_power(*data_.lights.back());
     }
   }
   entry.mesh = std::move(mesh);
   entry.material = std::move(material);
+  entry.media = media;
   data_.meshes.push_back(std::move(entry));
 }
 
 void SceneBuilder::add_sphere(const Sphere& sphere, MaterialPtr material,
-                              const AreaEmission* emission) {
+                              const AreaEmission* emission, MediumInterface media) {
   SceneData::SphereEntry entry;
   entry.sphere = sphere;
   entry.material = std::move(material);
   if (emission && !emission->radiance.is_black()) {
     entry.light = uint32_t(data_.lights.size());
     data_.lights.push_back(make_sphere_area_light(sphere, emission->radiance, emission->two_sided));
+    data_.lights.back()->media = media;
     check_power(*data_.lights.back());
   }
+  entry.media = media;
   data_.spheres.push_back(std::move(entry));
 }
 

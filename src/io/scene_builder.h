@@ -15,9 +15,18 @@ namespace caustica {
 class SceneBuilder {
  public:
   // mesh must already be in world space. With emission, every triangle becomes an area light.
-  void add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaEmission* emission = nullptr);
+  // A null material makes an interface: rays pass it (it may bound media, `media`).
+  void add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaEmission* emission = nullptr,
+                MediumInterface media = {});
   void add_sphere(const Sphere& sphere, MaterialPtr material,
-                  const AreaEmission* emission = nullptr);
+                  const AreaEmission* emission = nullptr, MediumInterface media = {});
+  // Absorbing media: add_medium returns the index MediumInterface names it by; the camera's
+  // (default) medium holds wherever no surface says otherwise (geometry/medium.h).
+  int16_t add_medium(const HomogeneousMedium& medium) {
+    data_.media.push_back(medium);
+    return int16_t(data_.media.size() - 1);
+  }
+  void set_default_medium(int16_t medium) { data_.default_medium = medium; }
   void add_light(LightPtr light);
   // An object placed many times (pbrt-v4 ObjectBegin / ObjectInstance) is stored once: its
   // meshes, in the object's own space and never emitting, go into a prototype, and each

@@ -15,6 +15,7 @@
 
 #include "core/rgb.h"
 #include "core/vec.h"
+#include "geometry/medium.h"
 
 namespace caustica {
 
@@ -96,6 +97,10 @@ class Light {
 
   // Index in the scene's light list (set by the scene), used to look up selection pmfs.
   uint32_t index = 0;
+  // An area light's surface may bound media: an end of a segment on it names the medium on its
+  // side (geometry/medium.h). Other lights name none.
+  MediumInterface media;
+  SegmentEnd medium_toward(Vec3 n, Vec3 w) const { return segment_end(media, n, w); }
 };
 
 using LightPtr = std::shared_ptr<Light>;

@@ -168,10 +168,23 @@ Scene::Scene(SceneData data)
       prototypes_(std::move(data.prototypes)),
       instances_(std::move(data.instances)),
       lights_(std::move(data.lights)),
+      media_(std::move(data.media)),
+      default_medium_(data.default_medium),
       camera_params_(data.camera),
       camera_(data.camera),
       settings_(std::move(data.settings)),
       name_(std::move(data.name)) {
+  auto check_medium = [&](int16_t m) {
+    if (m != kNoMedium && (m < 0 || size_t(m) >= media_.size()))
+      throw std::invalid_argument("a medium index is out of range");
+  };
+  check_medium(default_medium_);
+  for (const auto& e : meshes_) has_interfaces_ |= !e.material;
+  for (const auto& e : spheres_) has_interfaces_ |= !e.material;
+  for (const auto& proto : prototypes_)
+    for (const auto& e : proto.meshes) has_interfaces_ |= !e.material;
+  for (const auto& e : meshes_) check_medium(e.media.inside), check_medium(e.media.outside);
+  for (const auto& e : spheres_) check_medium(e.media.inside), check_medium(e.media.outside);
   build_accelerator();
 
   if (bounds_.empty()) bounds_.extend(Vec3(0, 0, 0));
@@ -350,6 +363,23 @@ bool Scene::occluded(const Ray& ray) const {
   fill_ray(ray, &r);
   rtcOccluded1(impl_->top.scene, &ctx, &r);
   return r.tfar < 0;
+}
+
+Rgb Scene::shadow_transmittance(Ray ray, SegmentEnd start, SegmentEnd end) const {
+  const float length_d = length(ray.d);  // ray.d may be unnormalised (Ray::spawn_ray_to)
+  Rgb tr(1.f);
+  for (int crossing = 0; crossing < kMaxInterfaceCrossings; ++crossing) {
+    SurfaceInteraction si;
+    if (!intersect(ray, &si)) return tr * transmittance(start, end, ray.tmax * length_d);
+    if (si.material) return Rgb(0.f);  // a surface that scatters blocks the ray
+    tr *= transmittance(start, si.medium_toward(-ray.d), si.t * length_d);
+    if (tr.is_black()) return tr;
+    start = si.medium_toward(ray.d);
+    const float remaining = ray.tmax - si.t;  // toward the same end point
+    ray = si.spawn_ray(ray.d);
+    ray.tmax = remaining;
+  }
+  return Rgb(0.f);
 }
 
 bool Scene::intersect(const Ray& ray, SurfaceInteraction* si) const {

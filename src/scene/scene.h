@@ -33,11 +33,13 @@ struct SceneData {
     TriangleMesh mesh;
     std::shared_ptr<const Material> material;
     uint32_t first_light = UINT32_MAX;  // index of triangle 0's area light, or none
+    MediumInterface media;
   };
   struct SphereEntry {
     Sphere sphere;
     std::shared_ptr<const Material> material;
     uint32_t light = UINT32_MAX;  // index of its area light, or none
+    MediumInterface media;
   };
   // An object defined once and placed many times (pbrt-v4 ObjectBegin / ObjectInstance): its
   // meshes in the object's own space, without emitters. The scene builds one Embree scene
@@ -54,6 +56,10 @@ struct SceneData {
   std::vector<Prototype> prototypes;
   std::vector<InstanceEntry> instances;
   std::vector<std::shared_ptr<class Light>> lights;
+  // Absorbing media (geometry/medium.h); a segment no surface assigns to one is in
+  // default_medium, the camera's.
+  std::vector<HomogeneousMedium> media;
+  int16_t default_medium = kNoMedium;
   CameraParams camera;
   SceneSettings settings;
   std::string name;
@@ -70,6 +76,13 @@ class Scene {
   bool intersect(const Ray& ray, SurfaceInteraction* si) const;
   // True if anything blocks the ray in (0, ray.tmax). Counts one ray.
   bool occluded(const Ray& ray) const;
+  // With absorbing media: what of the light along the shadow ray survives, 0 if a surface that
+  // has a material blocks it. Interfaces (no material) are passed, each piece between them in its
+  // own medium (geometry/medium.h); start and end are the shadow ray's ends. Counts a ray per
+  // piece. Integrators call it only where traces_transmittance(); else occluded() is the whole
+  // answer.
+  Rgb shadow_transmittance(Ray ray, SegmentEnd start, SegmentEnd end) const;
+  static constexpr int kMaxInterfaceCrossings = 64;
 
   const Camera& camera() const { return camera_; }
   // Re-creates the camera at another film resolution (command-line override; call before
@@ -81,6 +94,21 @@ class Scene {
   Bounds3 bounds() const { return bounds_; }
   const SceneSettings& settings() const { return settings_; }
   const std::string& name() const { return name_; }
+
+  // Absorbing media (geometry/medium.h). Without any, every transmittance is 1 and the
+  // integrators skip asking.
+  bool has_media() const { return !media_.empty(); }
+  // Media or interfaces (surfaces without a material): shadow rays must then go through
+  // shadow_transmittance rather than occluded().
+  bool traces_transmittance() const { return !media_.empty() || has_interfaces_; }
+  size_t medium_count() const { return media_.size(); }
+  int16_t default_medium() const { return default_medium_; }
+  // The fraction of light left after `distance` along the segment with these two ends (infinity
+  // for a ray that escapes: 0 inside an absorbing medium).
+  Rgb transmittance(SegmentEnd a, SegmentEnd b, float distance) const {
+    const int16_t m = medium_between(a, b, default_medium_);
+    return m < 0 ? Rgb(1.f) : media_[size_t(m)].transmittance(distance);
+  }
   // Triangles as rendered: each instance counts its prototype's triangles again.
   size_t triangle_count() const;
   // Triangles held in memory: each prototype counted once.
@@ -135,6 +163,9 @@ class Scene {
   std::vector<SceneData::Prototype> prototypes_;
   std::vector<SceneData::InstanceEntry> instances_;
   std::vector<std::shared_ptr<Light>> lights_;
+  std::vector<HomogeneousMedium> media_;
+  int16_t default_medium_ = kNoMedium;
+  bool has_interfaces_ = false;
   std::vector<const Light*> light_ptrs_, infinite_lights_;
   std::unique_ptr<LightSampler> light_sampler_;
   CameraParams camera_params_;

@@ -139,6 +139,7 @@ void Scene::complete_hit(uint32_t inst_id, uint32_t geom_id, uint32_t prim_id, f
     complete_sphere(e.sphere, p_sphere, si);
     si->material = e.material.get();
     si->area_light = e.light != UINT32_MAX ? lights_[e.light].get() : nullptr;
+    si->media = e.media;
     return;
   }
   const SceneData::MeshEntry& e = mesh_entry(inst_id, geom_id);
@@ -148,6 +149,7 @@ void Scene::complete_hit(uint32_t inst_id, uint32_t geom_id, uint32_t prim_id, f
         instance_rounding(instances_[impl_->instance_of_geom[inst_id]].object_to_world, si->p);
   si->material = e.material.get();
   si->area_light = e.first_light != UINT32_MAX ? lights_[e.first_light + prim_id].get() : nullptr;
+  si->media = e.media;
 }
 
 uint32_t Scene::primitive_index(const SurfaceInteraction& si) const {

@@ -112,15 +112,18 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   bool specular_path = true;  // every bounce so far was specular
   float segment = 0;
   float eta_scale = 1;
-  bool through_interface = false;  // the ray passed a surface without a BSDF
+  bool through_interface = false;  // the ray passed a material without a BSDF here
+  // Absorbing media (geometry/medium.h): each segment's transmittance goes into beta.
+  const bool media = scene.has_media();
+  SegmentEnd start;  // the first end of `ray` (the camera's names no medium)
   // guided-bpt / guided-vcm learning radiance from camera subpaths: this pixel's records.
   std::optional<SubpathRecords> radiance_records;
   if (tech_.guided && guiding_.records_radiance_pixel(pixel))
     radiance_records.emplace(arena, max_depth);
   // Emitters: MIS-weighted when connections take part, else only via delta-only chains. An
   // area light seen straight from the lens is weighted against the light subpaths' emission
-  // points connected to the lens, unless the ray passed an interface (that connection's shadow
-  // ray stops there).
+  // points connected to the lens, unless the ray passed a material without a BSDF there (that
+  // connection's shadow ray stops at it; it passes surfaces without a material).
   TechniqueTerms terms;
   bool weighted = false;  // the last emitter weight came from terms
   auto emitter_weight = [&](const Light& light, const SurfaceInteraction* hit, const MisSums& m) {
@@ -143,6 +146,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
   for (;;) {
     SurfaceInteraction si;
     if (!scene.intersect(ray, &si)) {
+      if (media) beta *= scene.transmittance(start, {}, kInfinity);
       for_each_emitter_seen(scene.infinite_lights(), ray, nullptr, [&](const Light& l, Rgb Le) {
         const float w = emitter_weight(l, nullptr, mis);
         if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w, weighted ? &terms : nullptr);
@@ -150,6 +154,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
       break;
     }
     segment += si.t;
+    if (media) beta *= scene.transmittance(start, si.medium_toward(-ray.d), si.t);
     Bsdf bsdf;
     if (si.material) bsdf = si.material->bsdf(si, arena);
     MisSums at_hit = mis;
@@ -164,8 +169,11 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
       if (w > 0) acc.add(false, 0, depth + 2, beta * Le * w, weighted ? &terms : nullptr);
     });
     if (!bsdf.valid()) {
+      start = si.medium_toward(ray.d);
       ray = si.spawn_ray(ray.d);
-      through_interface = true;
+      // Shadow rays pass surfaces without a material (Scene::shadow_transmittance) but stop at
+      // a material that has no BSDF here (a mix with an interface).
+      if (si.material) through_interface = true;
       continue;
     }
     ++depth;
@@ -214,6 +222,7 @@ void BidirIntegrator::camera_path(const Scene& scene, const Iteration& it,
     eta_scale *= sqr(step->eta);
     if (beta.is_black()) break;
     prev_p = si.p;
+    start = si.medium_toward(step->wi);
     ray = si.spawn_ray(step->wi);
     if (tech_.guided ? !survives_guided_roulette(beta, rr_beta, eta_scale, depth, rng)
                      : !survives_russian_roulette(beta, eta_scale, depth, rng))
@@ -261,7 +270,10 @@ void BidirIntegrator::next_event(const Scene& scene, const MisRules& rules, cons
   if (q < 1 && rng.next_float() >= q) return;
   // The shadow ray before the MIS terms: an occluded light costs no densities (a coated
   // BSDF's are random walks). The same contributions are made.
-  const bool occluded = scene.occluded(d->shadow);
+  Rgb tr(1.f);  // through interfaces and absorbing media
+  const bool occluded = scene.traces_transmittance()
+                            ? (tr = light_sample_transmittance(scene, v.si, *d)).is_black()
+                            : scene.occluded(d->shadow);
   if (v.probabilities && guiding_.counts_techniques())
     guiding_.count_technique(GuidingField::kNextEvent, v.probabilities.leaf_toward(d->ls.wi),
                              !occluded);
@@ -270,7 +282,7 @@ void BidirIntegrator::next_event(const Scene& scene, const MisRules& rules, cons
       terms_next_event(rules, *d->light, d->pmf, d->ls, v.si, v.bsdf, v.mis, v.guides);
   terms.own_factor = rules.mis(q);
   const float w = terms.weight(rules.counts());
-  const Rgb value = v.beta * d->f * d->ls.radiance * (w / (d->pmf * d->ls.pdf_w * q));
+  const Rgb value = v.beta * d->f * (d->ls.radiance * tr) * (w / (d->pmf * d->ls.pdf_w * q));
   if (value.is_black()) return;
   acc.add(false, 1, v.depth + 1, value, &terms);
 }
@@ -353,7 +365,13 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
     if (f_light.is_black()) continue;
     ++acc.work.connections;
     // The shadow ray before the MIS terms, as for next event estimation.
-    const bool occluded = scene.occluded(spawn_ray_between(si, light_si));
+    Rgb tr(1.f);  // through interfaces and absorbing media
+    const bool occluded =
+        scene.traces_transmittance()
+            ? (tr = scene.shadow_transmittance(spawn_ray_between(si, light_si),
+                                               si.medium_toward(dir), light_si.medium_toward(-dir)))
+                  .is_black()
+            : scene.occluded(spawn_ray_between(si, light_si));
     if (probabilities && guiding_.counts_techniques())
       guiding_.count_technique(GuidingField::kConnection, probabilities.leaf_toward(-dir),
                                !occluded);
@@ -367,7 +385,7 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
                                             cv.mis, rebuilt.guides, cv.guides);
     terms.own_factor = rules.mis(q);
     const float w = terms.weight(rules.counts());
-    const Rgb value = beta * v.throughput * f_camera * f_light * (w / (dist2 * q));
+    const Rgb value = beta * v.throughput * tr * f_camera * f_light * (w / (dist2 * q));
     if (value.is_black()) continue;
     acc.add(false, v.depth + 1, depth + 1, value, &terms,
             own ? AdaptivePlan::Share::OwnLightPath : AdaptivePlan::Share::RandomLightPath);

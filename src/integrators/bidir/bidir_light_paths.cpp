@@ -204,14 +204,19 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
   if (it.rules.correlated()) track.emplace();
   float segment = 0;  // distance since the previous real vertex (interfaces are skipped)
   int depth = 0;
+  // Absorbing media (geometry/medium.h): each segment's transmittance goes into beta.
+  const bool media = scene.has_media();
+  SegmentEnd start = media ? light->medium_toward(le->n, ray.d) : SegmentEnd{};
   for (;;) {
     SurfaceInteraction si;
     ++chunk.rays;
     if (!scene.intersect(ray, &si)) break;
     segment += si.t;
+    if (media) beta *= scene.transmittance(start, si.medium_toward(-ray.d), si.t);
     Bsdf bsdf;
     if (si.material) bsdf = si.material->bsdf(si, arena);
     if (!bsdf.valid()) {
+      start = si.medium_toward(ray.d);
       ray = si.spawn_ray(ray.d);
       continue;
     }
@@ -257,6 +262,7 @@ void BidirIntegrator::trace_light_path(const Scene& scene, const Iteration& it, 
                                step->weight, step->bsdf_pdf, step->guide_pdf, beta, Rgb(0.f)});
     }
     if (beta.is_black()) break;
+    start = si.medium_toward(step->wi);
     ray = si.spawn_ray(step->wi);
     // Russian roulette on the throughput relative to the emitted one (importance carries no
     // radiance scaling at refractions, so no eta correction); guided, on the larger of it and
@@ -334,10 +340,17 @@ void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Itera
   // The shadow ray before the splats and their MIS terms (up to 16 pixels under a wide filter).
   const Vec3 o =
       le.p + face_forward(le.n, cs->wi) * (1e-4f * std::max(1.f, max_component(abs(le.p))));
-  if (scene.occluded({o, cs->p_lens - o, 1.f - 1e-4f})) return;
+  const Ray shadow{o, cs->p_lens - o, 1.f - 1e-4f};
+  Rgb seen = radiance;
+  if (scene.traces_transmittance()) {  // through interfaces and absorbing media
+    seen *= scene.shadow_transmittance(shadow, light.medium_toward(le.n, cs->wi), {});
+    if (seen.is_black()) return;
+  } else if (scene.occluded(shadow)) {
+    return;
+  }
   splat_lens_connection(
       camera, it, cs->raster, TechniqueImages::key(false, 1, 1),
-      [&](float w) { return radiance * (scale * w); },
+      [&](float w) { return seen * (scale * w); },
       [&](const MisRules& rules, float raster_density) {
         return terms_light_origin_to_camera(rules, lens, pos_pdf, raster_density);
       },
@@ -370,11 +383,17 @@ Rgb BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
       cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(it.plan.light_paths));
   // The shadow ray before the lens geometry's densities (a coated BSDF's reverse density is a
   // random walk) and the splats' MIS terms: the same splats are made.
-  const bool occluded = scene.occluded(si.spawn_ray_to(cs->p_lens));
+  Rgb tr(1.f);  // through interfaces and absorbing media
+  const bool occluded = scene.traces_transmittance()
+                            ? (tr = scene.shadow_transmittance(si.spawn_ray_to(cs->p_lens),
+                                                               si.medium_toward(cs->wi), {}))
+                                  .is_black()
+                            : scene.occluded(si.spawn_ray_to(cs->p_lens));
   if (probabilities && guiding_.counts_techniques())
     guiding_.count_technique(GuidingField::kLensConnection, probabilities.leaf_toward(cs->wi),
                              !occluded);
   if (occluded) return Rgb(0.f);
+  beta *= tr;
   const LensConnection lens = lens_connection(camera, si, bsdf, si.wo, cs->p_lens, guides);
   const float scale_taken = scale / q;
   const bool splatted = splat_lens_connection(

@@ -41,9 +41,9 @@ const SceneConverter::DirectiveEntry* SceneConverter::find_directive(std::string
       {"LightSource", &S::light_source, world},
       {"LookAt", &S::look_at, any},
       {"MakeNamedMaterial", &S::make_named_material, world},
-      {"MakeNamedMedium", &S::media, world},
+      {"MakeNamedMedium", &S::make_named_medium, any},
       {"Material", &S::material_directive, world},
-      {"MediumInterface", &S::media, world},
+      {"MediumInterface", &S::medium_interface, any},
       {"NamedMaterial", &S::named_material_directive, world},
       {"ObjectBegin", &S::object_begin, world},
       {"ObjectEnd", &S::object_end, world},
@@ -136,6 +136,7 @@ void SceneConverter::finish() {
     }
   }
   emit_instances();
+  builder_.set_default_medium(medium_interface_of(camera_media_).outside);
   camera_.camera_to_world = camera_from_world_ ? camera_from_world_->inverse() : Transform();
   builder_.set_camera(camera_);
 }

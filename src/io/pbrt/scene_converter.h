@@ -51,8 +51,15 @@ class SceneConverter final : public DirectiveHandler {
     ParamList params;
     SourceLocation where;
   };
+  // MediumInterface's names ("" is no medium), resolved once the whole file is read, since
+  // pbrt-v4 lets a medium be named before MakeNamedMedium defines it.
+  struct MediumNames {
+    std::string inside, outside;
+    SourceLocation where;
+  };
   struct GraphicsState {
     Transform ctm;
+    MediumNames media;
     bool reverse_orientation = false;
     MaterialRef material;
     std::optional<AreaLightDesc> area_light;
@@ -70,6 +77,7 @@ class SceneConverter final : public DirectiveHandler {
     MaterialRef material;
     std::optional<AreaLightDesc> emission;
     SourceLocation where;
+    MediumNames media;
   };
   struct InstanceRecord {  // one ObjectInstance of an object's triangle meshes
     std::string object;
@@ -126,7 +134,12 @@ class SceneConverter final : public DirectiveHandler {
   void object_begin(const Directive& d);
   void object_end(const Directive& d);
   void object_instance(const Directive& d);
-  void media(const Directive& d);  // MakeNamedMedium and MediumInterface
+
+  // Media (scene_converter_media.cpp).
+  void make_named_medium(const Directive& d);
+  void medium_interface(const Directive& d);
+  int16_t medium_index(const std::string& name, const SourceLocation& where) const;
+  MediumInterface medium_interface_of(const MediumNames& names) const;
   MaterialPtr material(const MaterialRef& ref);
   MaterialPtr named_material(const std::string& name, const SourceLocation& where);
 
@@ -137,8 +150,10 @@ class SceneConverter final : public DirectiveHandler {
 
   // Handing shapes to the builder (scene_converter_shapes.cpp).
   void emit_shape(const ShapeRecord& record);
-  void emit_sphere(const ShapeRecord& record, const Sphere& sphere, const MaterialPtr& m);
-  void emit_mesh(const ShapeRecord& record, TriangleMesh mesh, bool quadric, const MaterialPtr& m);
+  void emit_sphere(const ShapeRecord& record, const Sphere& sphere, const MaterialPtr& m,
+                   MediumInterface media);
+  void emit_mesh(const ShapeRecord& record, TriangleMesh mesh, bool quadric, const MaterialPtr& m,
+                 MediumInterface media);
 
   // Objects' prototypes and instances (scene_converter_instances.cpp).
   static bool instanced(const ShapeRecord& record);  // placed by instances, not copied
@@ -168,6 +183,9 @@ class SceneConverter final : public DirectiveHandler {
   std::map<std::string, MaterialDef> named_materials_;
   std::map<std::string, MaterialPtr> named_created_;
   std::vector<std::string> creating_;  // named materials being created (cycle check for mix)
+
+  std::map<std::string, std::optional<int16_t>> media_;  // nullopt: a kind not supported
+  MediumNames camera_media_;
 
   std::vector<ShapeRecord> shapes_;
   std::map<std::string, std::vector<ShapeRecord>> objects_;

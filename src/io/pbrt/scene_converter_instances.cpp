@@ -9,9 +9,11 @@
 namespace caustica::pbrt {
 
 // Spheres stay exact only under a similarity of the whole transform, and a tessellated
-// quadric's orientation depends on the whole transform's handedness: those are copied.
+// quadric's orientation depends on the whole transform's handedness: those are copied, as are
+// shapes that bound media (the prototypes' meshes carry no medium interface).
 bool SceneConverter::instanced(const ShapeRecord& r) {
-  return r.geometry->mesh && !r.geometry->sphere_radius && !r.geometry->quadric;
+  return r.geometry->mesh && !r.geometry->sphere_radius && !r.geometry->quadric &&
+         r.media.inside == r.media.outside;
 }
 
 SceneConverter::PrototypeRef SceneConverter::emit_prototype(
@@ -20,7 +22,7 @@ SceneConverter::PrototypeRef SceneConverter::emit_prototype(
   for (const ShapeRecord& r : shapes) {
     if (!instanced(r)) continue;
     MaterialPtr m = material(r.material);
-    if (!m) continue;  // "interface": only bounds media, which are not supported
+    if (!m) continue;  // "interface" bounding no medium (else the shape is copied)
     const Transform& t = r.object_to_world;  // the shape's transform inside the definition
     if (!is_invertible(t)) {
       ctx_.warnings.warn(r.where, "shape with a singular transformation skipped", "singular shape");

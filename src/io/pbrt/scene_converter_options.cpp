@@ -34,6 +34,7 @@ void SceneConverter::camera(const Directive& d) {
   if (!is_invertible(state_.ctm))
     throw SceneLoadError(d.where, "Camera: the current transformation is singular");
   camera_from_world_ = state_.ctm;
+  camera_media_ = state_.media;  // pbrt-v4: the camera is in the current outside medium
   coordinate_systems_["camera"] = state_.ctm.inverse();
   if (d.args[0] != "perspective") {
     ctx_.warnings.warn(

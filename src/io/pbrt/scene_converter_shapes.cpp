@@ -24,7 +24,8 @@ void check_area_emission(Rgb radiance, const AreaLightDesc& light) {
 
 void SceneConverter::emit_shape(const ShapeRecord& r) {
   MaterialPtr m = material(r.material);
-  if (!m) return;  // "interface": only bounds media, which are not supported
+  const MediumInterface media = medium_interface_of(r.media);
+  if (!m && !media.transition()) return;  // "interface" that bounds no medium: nothing to see
   const ShapeGeometry& g = *r.geometry;
   const Transform& t = r.object_to_world;
   if (!is_invertible(t)) {
@@ -32,7 +33,7 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
     return;
   }
   if (!g.sphere_radius) {
-    emit_mesh(r, *g.mesh, g.quadric, m);
+    emit_mesh(r, *g.mesh, g.quadric, m, media);
     return;
   }
   if (std::optional<float> s = similarity_scale(t)) {
@@ -41,17 +42,18 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
     sphere.radius = *g.sphere_radius * *s;
     // pbrt-v4 flips a quadric's normal when its transform swaps handedness.
     sphere.reverse_orientation = r.reverse_orientation != t.swaps_handedness();
-    emit_sphere(r, sphere, m);
+    emit_sphere(r, sphere, m, media);
     return;
   }
   ctx_.warnings.warn(r.where,
                      "sphere under a non-uniform scale or shear is tessellated into triangles",
                      "tessellated sphere");
   emit_mesh(r, tessellate_sphere(*g.sphere_radius, -*g.sphere_radius, *g.sphere_radius, 360), true,
-            m);
+            m, media);
 }
 
-void SceneConverter::emit_sphere(const ShapeRecord& r, const Sphere& sphere, const MaterialPtr& m) {
+void SceneConverter::emit_sphere(const ShapeRecord& r, const Sphere& sphere, const MaterialPtr& m,
+                                 MediumInterface media) {
   if (!is_finite(sphere.center) || !std::isfinite(sphere.radius)) {
     ctx_.warnings.warn(r.where, "shape with non-finite coordinates skipped", "non-finite shape");
     return;
@@ -67,12 +69,12 @@ void SceneConverter::emit_sphere(const ShapeRecord& r, const Sphere& sphere, con
     }
     check_area_emission(e.radiance, *r.emission);
   }
-  builder_.add_sphere(sphere, m, r.emission ? &e : nullptr);
+  builder_.add_sphere(sphere, m, r.emission ? &e : nullptr, media);
 }
 
 // `mesh` is in object space; a quadric's is flipped like the sphere's normal above.
 void SceneConverter::emit_mesh(const ShapeRecord& r, TriangleMesh mesh, bool quadric,
-                               const MaterialPtr& m) {
+                               const MaterialPtr& m, MediumInterface media) {
   if (mesh.indices.empty()) return;
   const Transform& t = r.object_to_world;
   mesh.transform(t);
@@ -84,12 +86,12 @@ void SceneConverter::emit_mesh(const ShapeRecord& r, TriangleMesh mesh, bool qua
       return;
     }
   if (!r.emission) {
-    builder_.add_mesh(std::move(mesh), m, nullptr);
+    builder_.add_mesh(std::move(mesh), m, nullptr, media);
     return;
   }
   AreaEmission e{r.emission->radiance, r.emission->two_sided};
   if (r.emission->power <= 0) {
-    builder_.add_mesh(std::move(mesh), m, &e);
+    builder_.add_mesh(std::move(mesh), m, &e, media);
     return;
   }
   // pbrt-v4 gives "power" to each shape, and each triangle is a shape: one mesh per triangle.
@@ -109,7 +111,7 @@ void SceneConverter::emit_mesh(const ShapeRecord& r, TriangleMesh mesh, bool qua
                                            diffuse_area_light_power_per_radiance(area, e.two_sided))
                            : Rgb(0.f);
     check_area_emission(ei.radiance, *r.emission);
-    builder_.add_mesh(std::move(tri), m, &ei);
+    builder_.add_mesh(std::move(tri), m, &ei, media);
   }
 }
 

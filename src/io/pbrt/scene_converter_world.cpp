@@ -67,6 +67,7 @@ void SceneConverter::shape(const Directive& d) {
   r.reverse_orientation = state_.reverse_orientation;
   r.material = state_.material;
   r.where = d.where;
+  r.media = state_.media;
   if (state_.area_light) {
     if (current_object_)
       ctx_.warnings.warn(
@@ -136,12 +137,6 @@ void SceneConverter::object_instance(const Directive& d) {
     add_shape_record(std::move(copy));
   }
   if (any_instanced) instances_.push_back({d.args[0], world_from_instance, d.where});
-}
-
-void SceneConverter::media(const Directive& d) {
-  ctx_.warnings.warn(d.where, "participating media are not supported; " + d.name + " is ignored",
-                     "media " + d.name);
-  d.params.mark_all_used();
 }
 
 MaterialPtr SceneConverter::named_material(const std::string& name, const SourceLocation& where) {

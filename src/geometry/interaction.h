@@ -20,8 +20,12 @@ struct SurfaceInteraction {
                   // normal when the mesh has normals), outward for spheres
   Frame shading;  // shading frame; shading.n is the interpolated normal (ng if none)
   Vec2 uv;        // surface parameterisation (mesh uv, or sphere phi/theta)
-  Vec3 wo;        // unit direction back toward the ray origin
-  float t = 0;    // ray parameter of the hit
+  // dp/du and dp/dv of the shading geometry (pbrt-v4's shading.dpdu / dpdv): with per-vertex
+  // normals the uv tangent made perpendicular to the shading normal and cross(n, it), else the
+  // geometric derivatives. Bump mapping (materials/bump_mapped.cpp) displaces along them.
+  Vec3 dpdu, dpdv;
+  Vec3 wo;                            // unit direction back toward the ray origin
+  float t = 0;                        // ray parameter of the hit
   uint32_t geom_id = 0, prim_id = 0;  // Embree ids, for debugging and stored light vertices
   // The Embree instance (its geometry id in the top-level scene) of a hit on an instanced
   // object, whose geom_id and prim_id are then those in the object's own Embree scene.

@@ -73,6 +73,11 @@ MaterialPtr make_diffuse_transmission(TexturePtr reflectance, TexturePtr transmi
 // is a deterministic hash of the point, as pbrt-v4 does, so the result is a blend).
 MaterialPtr make_mix(MaterialPtr a, MaterialPtr b, TexturePtr amount);
 
+// pbrt-v4's "displacement" (bump mapping, materials/bump_mapped.cpp): inner's BSDF in the frame
+// of the surface displaced along its shading normal by the float texture. Returns inner itself
+// for a null or constant displacement (no slope) and for a null inner (an interface).
+MaterialPtr make_bump_mapped(MaterialPtr inner, TexturePtr displacement);
+
 // RGB of pbrt-v4's built-in named spectra: "metal-Au-eta", "metal-Au-k", "metal-Ag-*",
 // "metal-Cu-*", "metal-Al-*", "metal-CuZn-*", "glass-BK7", "glass-BAF10", ... (IORs are
 // returned as grey). Nothing if unknown.

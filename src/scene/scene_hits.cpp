@@ -25,6 +25,13 @@ void complete_sphere(const Sphere& s, Vec3 p_hit, SurfaceInteraction* si) {
   const float theta = safe_acos(local.z / s.radius);
   si->uv = {phi * kInv2Pi, 1.f - theta * kInvPi};
   const Vec3 dpdu(-2 * kPi * local.y, 2 * kPi * local.x, 0);
+  // pbrt-v4's dp/dv for v = 1 - theta / pi (theta from pi at z = -r to 0 at z = r).
+  const float z_radius = std::sqrt(local.x * local.x + local.y * local.y);
+  const float cos_phi = z_radius > 0 ? local.x / z_radius : 1.f,
+              sin_phi = z_radius > 0 ? local.y / z_radius : 0.f;
+  const float sin_theta = std::sqrt(std::max(0.f, 1.f - sqr(local.z / s.radius)));
+  si->dpdu = dpdu;
+  si->dpdv = Vec3(local.z * cos_phi, local.z * sin_phi, -s.radius * sin_theta) * -kPi;
   if (s.reverse_orientation) n = -n;
   si->ng = n;
   si->shading = Frame::from_normal_tangent(n, dpdu);
@@ -114,13 +121,27 @@ static void complete_triangle(const TriangleVertices& v, float b1, float b2,
   const Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
   const Vec3 dp02 = p0 - p2, dp12 = p1 - p2;
   const float det = duv02.x * duv12.y - duv02.y * duv12.x;
-  Vec3 dpdu = std::abs(det) > 1e-12f ? (dp02 * duv12.y - dp12 * duv02.y) / det : p1 - p0;
+  const bool uv_ok = std::abs(det) > 1e-12f;
+  Vec3 dpdu = uv_ok ? (dp02 * duv12.y - dp12 * duv02.y) / det : p1 - p0;
+  const Vec3 dpdv = uv_ok ? (dp12 * duv02.x - dp02 * duv12.x) / det : p2 - p0;
   Vec3 ns = ng;
+  si->dpdu = dpdu;
+  si->dpdv = dpdv;
   if (v.has_normals) {
     ns = v.n[0] * b0 + v.n[1] * b1 + v.n[2] * b2;
     const float len = length(ns);
     ns = len > 0 ? ns / len : ng;
     ng = face_forward(ng, ns);
+    // pbrt-v4's shading tangents: dp/du made perpendicular to ns, and cross(ns, it).
+    const Vec3 ts = cross(ns, dpdu);
+    if (length_squared(ts) > 0) {
+      si->dpdu = cross(ts, ns);
+      si->dpdv = ts;
+    } else {
+      const Frame f = Frame::from_normal(ns);
+      si->dpdu = f.s;
+      si->dpdv = f.t;
+    }
   } else if (v.reverse_orientation) {
     ng = -ng;
     ns = ng;

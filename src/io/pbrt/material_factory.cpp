@@ -261,8 +261,8 @@ float MaterialFactory::eta(const ParamList& params, const std::string& name) {
 MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamList& params,
                                            const SourceLocation& where,
                                            const NamedMaterialLookup& named) {
-  if (params.find("displacement"))
-    ctx_.warnings.warn(where, "material displacement is not supported; ignored", "displacement");
+  // Bump mapping wraps whatever the type makes (materials/bump_mapped.cpp).
+  const TexturePtr displacement = float_texture(params, "displacement", std::nullopt);
   if (params.find("normalmap"))
     ctx_.warnings.warn(where, "normal maps are not supported; ignored", "normalmap");
   const float kInf = std::numeric_limits<float>::infinity();
@@ -310,7 +310,7 @@ MaterialPtr MaterialFactory::make_material(const std::string& type, const ParamL
     throw SceneLoadError(where, "unknown material type " + quote_excerpt(type));
   }
   params.report_unused(ctx_.warnings, "Material " + quote_excerpt(type));
-  return m;
+  return make_bump_mapped(std::move(m), displacement);
 }
 
 // The conductor's complex IOR or reflectance (names after `prefix` for eta and k: "conductor."

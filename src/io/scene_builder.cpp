@@ -23,7 +23,7 @@ void check_mesh(const TriangleMesh& mesh) {
 }  // namespace
 
 void SceneBuilder::add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaEmission* emission,
-                            MediumInterface media) {
+                            MediumInterface media, TexturePtr alpha) {
   check_mesh(mesh);
   SceneData::MeshEntry entry;
   if (emission && !emission->radiance.is_black()) {
@@ -38,6 +38,7 @@ void SceneBuilder::add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaE
   entry.mesh = std::move(mesh);
   entry.material = std::move(material);
   entry.media = media;
+  entry.alpha = std::move(alpha);
   data_.meshes.push_back(std::move(entry));
 }
 

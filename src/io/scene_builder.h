@@ -16,8 +16,9 @@ class SceneBuilder {
  public:
   // mesh must already be in world space. With emission, every triangle becomes an area light.
   // A null material makes an interface: rays pass it (it may bound media, `media`).
+  // alpha: pbrt-v4's alpha mask (SceneData::MeshEntry::alpha), null for opaque.
   void add_mesh(TriangleMesh mesh, MaterialPtr material, const AreaEmission* emission = nullptr,
-                MediumInterface media = {});
+                MediumInterface media = {}, TexturePtr alpha = nullptr);
   void add_sphere(const Sphere& sphere, MaterialPtr material,
                   const AreaEmission* emission = nullptr, MediumInterface media = {});
   // Absorbing media: add_medium returns the index MediumInterface names it by; the camera's

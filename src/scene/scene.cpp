@@ -5,10 +5,12 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
+#include "core/rng.h"
 #include "lights/light.h"
 #include "lights/light_sampler.h"
 #include "scene/scene_impl.h"
@@ -81,6 +83,46 @@ void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
   if (sphere_hit(s, o, d, ray->tnear, ray->tfar) >= 0) ray->tfar = -kInfinity;
 }
 
+// pbrt-v4's alpha masks, as an Embree filter for closest-hit and occlusion rays alike: a hit where
+// the mesh's alpha texture is 0 is ignored; where it is in (0, 1), it is kept with that
+// probability, decided by a hash of the ray's origin and direction (pbrt-v4's HashFloat(o, d)),
+// so that the same ray always decides alike. Embree calls this from C code: it must not throw.
+float ray_hash_float(const float o[3], const float d[3]) {
+  uint64_t h = 0x616c706861ull;  // "alpha"
+  for (int k = 0; k < 3; ++k) h = hash_combine(h, std::bit_cast<uint32_t>(o[k]));
+  for (int k = 0; k < 3; ++k) h = hash_combine(h, std::bit_cast<uint32_t>(d[k]));
+  return float(h >> 40) * 0x1p-24f;
+}
+
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* e = static_cast<const SceneData::MeshEntry*>(args->geometryUserPtr);
+  const TriangleMesh& m = e->mesh;
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+    const float b1 = RTCHitN_u(args->hit, args->N, i), b2 = RTCHitN_v(args->hit, args->N, i),
+                b0 = 1 - b1 - b2;
+    const uint32_t* idx = &m.indices[3 * size_t(prim)];
+    Vec2 uv[3] = {{0, 0}, {1, 0}, {1, 1}};  // as TriangleVertices without uvs
+    if (!m.uvs.empty())
+      for (int k = 0; k < 3; ++k) uv[k] = m.uvs[idx[k]];
+    const Vec3 p = m.positions[idx[0]] * b0 + m.positions[idx[1]] * b1 + m.positions[idx[2]] * b2;
+    const float a = e->alpha->eval_float({uv[0] * b0 + uv[1] * b1 + uv[2] * b2, p});
+    if (a >= 1) continue;
+    bool masked = !(a > 0);
+    if (!masked) {
+      const float o[3] = {RTCRayN_org_x(args->ray, args->N, i),
+                          RTCRayN_org_y(args->ray, args->N, i),
+                          RTCRayN_org_z(args->ray, args->N, i)};
+      const float d[3] = {RTCRayN_dir_x(args->ray, args->N, i),
+                          RTCRayN_dir_y(args->ray, args->N, i),
+                          RTCRayN_dir_z(args->ray, args->N, i)};
+      masked = ray_hash_float(o, d) > a;
+    }
+    if (masked) args->valid[i] = 0;
+  }
+}
+
 // Embree calls this from C code: never throw here; the constructor checks the device after.
 void embree_error(void* user, RTCError, const char* str) {
   auto* message = static_cast<std::string*>(user);
@@ -115,6 +157,11 @@ void attach_meshes(RTCDevice device, const std::vector<SceneData::MeshEntry>& me
     auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
         g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), m.triangle_count()));
     std::copy(m.indices.begin(), m.indices.end(), ib);
+    if (meshes[mi].alpha) {
+      rtcSetGeometryUserData(g, const_cast<SceneData::MeshEntry*>(&meshes[mi]));
+      rtcSetGeometryIntersectFilterFunction(g, alpha_filter);
+      rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
+    }
     rtcCommitGeometry(g);
     const unsigned id = rtcAttachGeometry(table->scene, g);
     rtcReleaseGeometry(g);

@@ -11,6 +11,7 @@
 #include "geometry/camera.h"
 #include "geometry/interaction.h"
 #include "geometry/shapes.h"
+#include "geometry/texture.h"
 
 namespace caustica {
 
@@ -34,6 +35,9 @@ struct SceneData {
     std::shared_ptr<const Material> material;
     uint32_t first_light = UINT32_MAX;  // index of triangle 0's area light, or none
     MediumInterface media;
+    // pbrt-v4's alpha mask (null: opaque): rays ignore a hit where it is 0 and keep one where it
+    // is in (0, 1) with that probability, by a hash of the ray (scene.cpp, alpha_filter).
+    TexturePtr alpha;
   };
   struct SphereEntry {
     Sphere sphere;

@@ -78,6 +78,7 @@ class SceneConverter final : public DirectiveHandler {
     std::optional<AreaLightDesc> emission;
     SourceLocation where;
     MediumNames media;
+    TexturePtr alpha;  // pbrt-v4's alpha mask; null: opaque
   };
   struct InstanceRecord {  // one ObjectInstance of an object's triangle meshes
     std::string object;

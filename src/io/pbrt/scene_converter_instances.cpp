@@ -10,10 +10,10 @@ namespace caustica::pbrt {
 
 // Spheres stay exact only under a similarity of the whole transform, and a tessellated
 // quadric's orientation depends on the whole transform's handedness: those are copied, as are
-// shapes that bound media (the prototypes' meshes carry no medium interface).
+// shapes that bound media or have an alpha mask (the prototypes' meshes carry neither).
 bool SceneConverter::instanced(const ShapeRecord& r) {
   return r.geometry->mesh && !r.geometry->sphere_radius && !r.geometry->quadric &&
-         r.media.inside == r.media.outside;
+         r.media.inside == r.media.outside && !r.alpha;
 }
 
 SceneConverter::PrototypeRef SceneConverter::emit_prototype(

@@ -36,7 +36,8 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
     emit_mesh(r, *g.mesh, g.quadric, m, media);
     return;
   }
-  if (std::optional<float> s = similarity_scale(t)) {
+  // An alpha mask is a filter on triangles: a masked sphere is tessellated, with its uv.
+  if (std::optional<float> s = r.alpha ? std::nullopt : similarity_scale(t)) {
     Sphere sphere;
     sphere.center = t.point({0, 0, 0});
     sphere.radius = *g.sphere_radius * *s;
@@ -45,9 +46,10 @@ void SceneConverter::emit_shape(const ShapeRecord& r) {
     emit_sphere(r, sphere, m, media);
     return;
   }
-  ctx_.warnings.warn(r.where,
-                     "sphere under a non-uniform scale or shear is tessellated into triangles",
-                     "tessellated sphere");
+  if (!r.alpha)
+    ctx_.warnings.warn(r.where,
+                       "sphere under a non-uniform scale or shear is tessellated into triangles",
+                       "tessellated sphere");
   emit_mesh(r, tessellate_sphere(*g.sphere_radius, -*g.sphere_radius, *g.sphere_radius, 360), true,
             m, media);
 }
@@ -86,12 +88,12 @@ void SceneConverter::emit_mesh(const ShapeRecord& r, TriangleMesh mesh, bool qua
       return;
     }
   if (!r.emission) {
-    builder_.add_mesh(std::move(mesh), m, nullptr, media);
+    builder_.add_mesh(std::move(mesh), m, nullptr, media, r.alpha);
     return;
   }
   AreaEmission e{r.emission->radiance, r.emission->two_sided};
   if (r.emission->power <= 0) {
-    builder_.add_mesh(std::move(mesh), m, &e, media);
+    builder_.add_mesh(std::move(mesh), m, &e, media, r.alpha);
     return;
   }
   // pbrt-v4 gives "power" to each shape, and each triangle is a shape: one mesh per triangle.
@@ -111,7 +113,7 @@ void SceneConverter::emit_mesh(const ShapeRecord& r, TriangleMesh mesh, bool qua
                                            diffuse_area_light_power_per_radiance(area, e.two_sided))
                            : Rgb(0.f);
     check_area_emission(ei.radiance, *r.emission);
-    builder_.add_mesh(std::move(tri), m, &ei, media);
+    builder_.add_mesh(std::move(tri), m, &ei, media, r.alpha);
   }
 }
 

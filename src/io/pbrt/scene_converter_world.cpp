@@ -50,12 +50,19 @@ void SceneConverter::area_light_source(const Directive& d) {
 
 void SceneConverter::shape(const Directive& d) {
   ParamList params = with_attributes(d.params, "shape");
-  if (const Param* alpha = params.find("alpha", {ParamType::Float, ParamType::Texture})) {
-    if (alpha->type == ParamType::Float && alpha->numbers.size() == 1 && alpha->numbers[0] == 0) {
+  TexturePtr alpha;  // pbrt-v4's alpha mask (scene/scene.h, MeshEntry::alpha)
+  if (const Param* ap = params.find("alpha", {ParamType::Float, ParamType::Texture})) {
+    if (ap->type == ParamType::Float && ap->numbers.size() == 1 && ap->numbers[0] == 0) {
       params.mark_all_used();
       return;  // fully transparent: pbrt-v4 drops such shapes too
     }
-    ctx_.warnings.warn(alpha->where, "alpha masks are not supported; shapes are opaque", "alpha");
+    alpha = factory_.float_texture(params, "alpha", std::nullopt);
+    if (alpha->is_constant() && alpha->eval_float({}) >= 1) alpha = nullptr;  // opaque
+    if (alpha && state_.area_light)
+      ctx_.warnings.warn(ap->where,
+                         "an alpha mask on an area light masks the rays that reach it, not what "
+                         "it emits",
+                         "alpha area light");
   }
   for (const char* ignored : {"emissionfilename"}) params.find(ignored);
   std::optional<ShapeGeometry> g = make_shape(d.args[0], params, d.where, ctx_);
@@ -68,6 +75,7 @@ void SceneConverter::shape(const Directive& d) {
   r.material = state_.material;
   r.where = d.where;
   r.media = state_.media;
+  r.alpha = std::move(alpha);
   if (state_.area_light) {
     if (current_object_)
       ctx_.warnings.warn(

@@ -148,5 +148,15 @@ TEST(Texture, CheckerboardEvaluatesNestedTextures) {
   expect_rgb_near(lookup(board, 1.2f, 0.7f), Rgb(0.9f));
 }
 
+// pbrt-v4's float image textures read the first channel of an RGB image (its MIP map's Texel<Float>
+// is channel 0), not the mean of the three.
+TEST(Texture, FloatImageTexturesReadTheFirstChannel) {
+  auto image = std::make_shared<Image>(1, 1);
+  image->at(0, 0) = Rgb(0.2f, 0.6f, 1.0f);
+  const ImageTexture spectrum(image, {}), scalar(image, {}, Rgb(1.f), false, true);
+  EXPECT_NEAR(spectrum.eval_float({{0.5f, 0.5f}, {}}), 0.6f, 1e-6f);
+  EXPECT_NEAR(scalar.eval_float({{0.5f, 0.5f}, {}}), 0.2f, 1e-6f);
+}
+
 }  // namespace
 }  // namespace caustica

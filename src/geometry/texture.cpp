@@ -9,8 +9,12 @@
 namespace caustica {
 
 ImageTexture::ImageTexture(std::shared_ptr<const Image> image, UvMapping mapping, Rgb scale,
-                           bool invert)
-    : image_(std::move(image)), mapping_(mapping), scale_(scale), invert_(invert) {
+                           bool invert, bool first_channel)
+    : image_(std::move(image)),
+      mapping_(mapping),
+      scale_(scale),
+      invert_(invert),
+      first_channel_(first_channel) {
   if (!image_ || image_->empty()) throw std::invalid_argument("ImageTexture: empty image");
 }
 
@@ -18,7 +22,9 @@ Rgb ImageTexture::eval(const TextureContext& ctx) const {
   const Vec2 st = mapping_.map(ctx.uv);
   // Texture space has t = 0 at the bottom, the image stores its top row first: flip t, as
   // pbrt-v4's SpectrumImageTexture::Evaluate does.
-  Rgb rgb = scale_ * image_->bilinear_wrap(st.x, 1.f - st.y);
+  Rgb texel = image_->bilinear_wrap(st.x, 1.f - st.y);
+  if (first_channel_) texel = Rgb(texel.r);
+  Rgb rgb = scale_ * texel;
   if (invert_) rgb = Rgb(1.f) - rgb;
   // pbrt-v4 clamps at zero after scale and invert, both with and without invert.
   return Rgb(std::max(rgb.r, 0.f), std::max(rgb.g, 0.f), std::max(rgb.b, 0.f));

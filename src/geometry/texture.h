@@ -48,12 +48,13 @@ struct UvMapping {
 // filter "bilinear" and wrap "repeat" (no MIP mapping). pbrt convention: (s, t) = mapping(uv)
 // and t = 0 is the bottom of the image (images are stored top row first), so the lookup is at
 // (s, 1 - t); texel centres sit at half-integer multiples of 1/width, 1/height. The result is
-// max(0, invert ? 1 - scale * texel : scale * texel), as pbrt-v4 computes it.
+// max(0, invert ? 1 - scale * texel : scale * texel), as pbrt-v4 computes it. A float texture
+// (first_channel) reads the image's first channel, as pbrt-v4's float MIP maps do, not the mean.
 class ImageTexture final : public Texture {
  public:
   // Throws std::invalid_argument if `image` is null or empty.
   ImageTexture(std::shared_ptr<const Image> image, UvMapping mapping, Rgb scale = Rgb(1.f),
-               bool invert = false);
+               bool invert = false, bool first_channel = false);
   Rgb eval(const TextureContext& ctx) const override;
 
  private:
@@ -61,6 +62,7 @@ class ImageTexture final : public Texture {
   UvMapping mapping_;
   Rgb scale_;
   bool invert_;
+  bool first_channel_;
 };
 
 // 2D checkerboard (pbrt-v4 "checkerboard", dimension 2, without its filtering): with

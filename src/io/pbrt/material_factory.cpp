@@ -211,7 +211,8 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
     params.find("maxanisotropy");
     const float scale = params.get_float("scale", 1);
     const bool invert = params.get_bool("invert", false);
-    tex = std::make_shared<ImageTexture>(load_image(path, srgb, *fp), mapping, Rgb(scale), invert);
+    tex = std::make_shared<ImageTexture>(load_image(path, srgb, *fp), mapping, Rgb(scale), invert,
+                                         is_float);
   } else if (cls == "bilerp" || cls == "directionmix" || cls == "dots" || cls == "fbm" ||
              cls == "wrinkled" || cls == "windy" || cls == "marble" || cls == "ptex") {
     ctx_.warnings.warn(

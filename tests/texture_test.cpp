@@ -158,5 +158,26 @@ TEST(Texture, FloatImageTexturesReadTheFirstChannel) {
   EXPECT_NEAR(scalar.eval_float({{0.5f, 0.5f}, {}}), 0.2f, 1e-6f);
 }
 
+// pbrt-v4's wrap modes beyond repeat: clamp repeats the edge texels, black reads 0 outside. A
+// 2 x 1 image (0 then 1): at s = 0.9 repeat blends the right texel with the left one across the
+// seam, clamp keeps the right one, black fades it toward 0; far outside, clamp is the edge.
+TEST(Texture, WrapModesRepeatClampAndBlack) {
+  auto image = std::make_shared<Image>(2, 1);
+  image->at(0, 0) = Rgb(0.f);
+  image->at(1, 0) = Rgb(1.f);
+  auto at = [&](Image::Wrap wrap, float s) {
+    return ImageTexture(image, {}, Rgb(1.f), false, false, wrap).eval_float({{s, 0.5f}, {}});
+  };
+  EXPECT_NEAR(at(Image::Wrap::Repeat, 0.9f), 0.7f, 1e-5f);
+  EXPECT_NEAR(at(Image::Wrap::Clamp, 0.9f), 1.f, 1e-5f);
+  EXPECT_NEAR(at(Image::Wrap::Black, 0.9f), 0.7f, 1e-5f);
+  EXPECT_NEAR(at(Image::Wrap::Black, 0.1f), 0.f, 1e-5f);
+  EXPECT_NEAR(at(Image::Wrap::Clamp, 0.1f), 0.f, 1e-5f);
+  EXPECT_NEAR(at(Image::Wrap::Repeat, 0.1f), 0.3f, 1e-5f);
+  EXPECT_NEAR(at(Image::Wrap::Clamp, 1e9f), 1.f, 1e-5f);
+  EXPECT_NEAR(at(Image::Wrap::Black, -1e9f), 0.f, 1e-5f);
+  EXPECT_NEAR(at(Image::Wrap::Black, 0.75f), 1.f, 1e-5f);  // a texel centre is exact
+}
+
 }  // namespace
 }  // namespace caustica

@@ -9,12 +9,13 @@
 namespace caustica {
 
 ImageTexture::ImageTexture(std::shared_ptr<const Image> image, UvMapping mapping, Rgb scale,
-                           bool invert, bool first_channel)
+                           bool invert, bool first_channel, Image::Wrap wrap)
     : image_(std::move(image)),
       mapping_(mapping),
       scale_(scale),
       invert_(invert),
-      first_channel_(first_channel) {
+      first_channel_(first_channel),
+      wrap_(wrap) {
   if (!image_ || image_->empty()) throw std::invalid_argument("ImageTexture: empty image");
 }
 
@@ -22,7 +23,7 @@ Rgb ImageTexture::eval(const TextureContext& ctx) const {
   const Vec2 st = mapping_.map(ctx.uv);
   // Texture space has t = 0 at the bottom, the image stores its top row first: flip t, as
   // pbrt-v4's SpectrumImageTexture::Evaluate does.
-  Rgb texel = image_->bilinear_wrap(st.x, 1.f - st.y);
+  Rgb texel = image_->bilinear(st.x, 1.f - st.y, wrap_);
   if (first_channel_) texel = Rgb(texel.r);
   Rgb rgb = scale_ * texel;
   if (invert_) rgb = Rgb(1.f) - rgb;

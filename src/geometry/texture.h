@@ -6,10 +6,9 @@
 
 #include "core/rgb.h"
 #include "core/vec.h"
+#include "image/image.h"
 
 namespace caustica {
-
-class Image;
 
 struct TextureContext {
   Vec2 uv;
@@ -53,8 +52,10 @@ struct UvMapping {
 class ImageTexture final : public Texture {
  public:
   // Throws std::invalid_argument if `image` is null or empty.
+  // wrap: what texels outside the image read (pbrt-v4's wrap modes repeat, clamp and black).
   ImageTexture(std::shared_ptr<const Image> image, UvMapping mapping, Rgb scale = Rgb(1.f),
-               bool invert = false, bool first_channel = false);
+               bool invert = false, bool first_channel = false,
+               Image::Wrap wrap = Image::Wrap::Repeat);
   Rgb eval(const TextureContext& ctx) const override;
 
  private:
@@ -63,6 +64,7 @@ class ImageTexture final : public Texture {
   Rgb scale_;
   bool invert_;
   bool first_channel_;
+  Image::Wrap wrap_;
 };
 
 // 2D checkerboard (pbrt-v4 "checkerboard", dimension 2, without its filtering): with

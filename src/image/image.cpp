@@ -1,5 +1,6 @@
 #include "image/image.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace caustica {
@@ -28,6 +29,26 @@ Rgb Image::bilinear_wrap(float s, float t) const {
   int y0 = wrap_index(int(yf), height_), y1 = wrap_index(int(yf) + 1, height_);
   return (1 - dx) * (1 - dy) * at(x0, y0) + dx * (1 - dy) * at(x1, y0) +
          (1 - dx) * dy * at(x0, y1) + dx * dy * at(x1, y1);
+}
+
+Rgb Image::bilinear(float s, float t, Wrap wrap) const {
+  if (wrap == Wrap::Repeat) return bilinear_wrap(s, t);
+  if (empty()) return Rgb(0.f);
+  // Beyond one image width outside, every texel a lookup touches is an edge texel (Clamp) or
+  // black (Black): clamping there keeps the int conversion below in range.
+  s = std::isfinite(s) ? std::clamp(s, -1.f, 2.f) : 0.f;
+  t = std::isfinite(t) ? std::clamp(t, -1.f, 2.f) : 0.f;
+  const float x = s * float(width_) - 0.5f, y = t * float(height_) - 0.5f;
+  const float xf = std::floor(x), yf = std::floor(y);
+  const float dx = x - xf, dy = y - yf;
+  auto texel = [&](int xi, int yi) {
+    if (wrap == Wrap::Clamp)
+      return at(std::clamp(xi, 0, width_ - 1), std::clamp(yi, 0, height_ - 1));
+    return xi < 0 || yi < 0 || xi >= width_ || yi >= height_ ? Rgb(0.f) : at(xi, yi);
+  };
+  const int x0 = int(xf), y0 = int(yf);
+  return (1 - dx) * (1 - dy) * texel(x0, y0) + dx * (1 - dy) * texel(x0 + 1, y0) +
+         (1 - dx) * dy * texel(x0, y0 + 1) + dx * dy * texel(x0 + 1, y0 + 1);
 }
 
 Rgb Image::average() const {

@@ -29,6 +29,10 @@ class Image {
 
   // Bilinear lookup at continuous coordinates st in [0,1)^2 (s right, t down), wrapping.
   Rgb bilinear_wrap(float s, float t) const;
+  // The same lookup with pbrt-v4's other wrap modes for texels outside the image: Clamp repeats
+  // the edge texels, Black reads 0 (Repeat is bilinear_wrap).
+  enum class Wrap { Repeat, Clamp, Black };
+  Rgb bilinear(float s, float t, Wrap wrap) const;
   Rgb average() const;
 
  private:

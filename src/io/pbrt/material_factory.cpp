@@ -204,15 +204,24 @@ void MaterialFactory::define_texture(const std::string& name, const std::string&
           "imagemap filter " + quote_excerpt(filter) + " is not supported; using bilinear",
           "filter " + filter);
     const std::string wrap = params.get_string("wrap", "repeat");
-    if (wrap != "repeat")
+    Image::Wrap wrap_mode = Image::Wrap::Repeat;
+    if (wrap == "clamp") {
+      wrap_mode = Image::Wrap::Clamp;
+    } else if (wrap == "black") {
+      wrap_mode = Image::Wrap::Black;
+    } else if (wrap == "octahedralsphere") {
       ctx_.warnings.warn(params.find("wrap")->where,
-                         "imagemap wrap " + quote_excerpt(wrap) + " is not supported; using repeat",
+                         "imagemap wrap \"octahedralsphere\" is not supported; using repeat",
                          "wrap " + wrap);
+    } else if (wrap != "repeat") {
+      param_error(*params.find("wrap"),
+                  "expected repeat, clamp, black or octahedralsphere, got " + quote_excerpt(wrap));
+    }
     params.find("maxanisotropy");
     const float scale = params.get_float("scale", 1);
     const bool invert = params.get_bool("invert", false);
     tex = std::make_shared<ImageTexture>(load_image(path, srgb, *fp), mapping, Rgb(scale), invert,
-                                         is_float);
+                                         is_float, wrap_mode);
   } else if (cls == "bilerp" || cls == "directionmix" || cls == "dots" || cls == "fbm" ||
              cls == "wrinkled" || cls == "windy" || cls == "marble" || cls == "ptex") {
     ctx_.warnings.warn(

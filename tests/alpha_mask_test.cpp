@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 
 #include "core/rng.h"
 #include "core/warp.h"
@@ -21,13 +20,15 @@ using test::with_camera;
 // An 8 x 1 single-channel PFM, four texels 0 then four 1: with bilinear lookup and repeat
 // wrapping the mask is 0 for s in [1/16, 7/16] and 1 for s in [9/16, 15/16].
 std::string mask_pfm(const test::TempDir& dir) {
-  std::string bytes = "Pf\n8 1\n-1.0\n";
-  for (float v : {0.f, 0.f, 0.f, 0.f, 1.f, 1.f, 1.f, 1.f}) {
-    char b[4];
-    std::memcpy(b, &v, 4);
-    bytes.append(b, 4);
-  }
-  return dir.write("mask.pfm", bytes);
+  return test::write_row_pfm(dir, "mask.pfm", {0, 0, 0, 0, 1, 1, 1, 1});
+}
+
+// The mask as the float texture "mask", before `world`, loaded from a file in dir.
+std::unique_ptr<Scene> load_with_mask(const test::TempDir& dir, const std::string& world) {
+  return test::load_file_text(
+      dir, "alpha.pbrt",
+      with_camera("Texture \"mask\" \"float\" \"imagemap\" \"string filename\" \"" + mask_pfm(dir) +
+                  "\"\n" + world));
 }
 
 // A unit quad at z = 0 with uv = (x, y), and a diffuse floor at z = -1 behind it.
@@ -40,13 +41,8 @@ const char* kFloor =
 
 TEST(AlphaMask, TexturedMaskLetsRaysThroughWhereItIsZero) {
   test::TempDir dir;
-  test::captured_warnings().clear();
-  auto scene = load_pbrt(
-      dir.write("alpha.pbrt",
-                with_camera("Texture \"mask\" \"float\" \"imagemap\" \"string filename\" \"" +
-                            mask_pfm(dir) + "\"\n" + kQuadAndFloor + " \"texture alpha\" \"mask\"" +
-                            kFloor)),
-      test::capture_warning);
+  auto scene =
+      load_with_mask(dir, std::string(kQuadAndFloor) + " \"texture alpha\" \"mask\"" + kFloor);
   EXPECT_TRUE(test::captured_warnings().empty());
   SurfaceInteraction si;
   ASSERT_TRUE(scene->intersect({{0.2f, 0.5f, 1}, {0, 0, -1}, kInfinity}, &si));
@@ -87,12 +83,7 @@ TEST(AlphaMask, OpaqueAndTransparentConstants) {
 
 TEST(AlphaMask, AMaskedSphereIsTessellatedWithItsUv) {
   test::TempDir dir;
-  test::captured_warnings().clear();
-  auto scene = load_pbrt(
-      dir.write("sphere.pbrt",
-                with_camera("Texture \"mask\" \"float\" \"imagemap\" \"string filename\" \"" +
-                            mask_pfm(dir) + "\"\nShape \"sphere\" \"texture alpha\" \"mask\"\n")),
-      test::capture_warning);
+  auto scene = load_with_mask(dir, "Shape \"sphere\" \"texture alpha\" \"mask\"\n");
   EXPECT_TRUE(test::captured_warnings().empty());
   EXPECT_EQ(scene->sphere_count(), 0u);
   EXPECT_GT(scene->triangle_count(), 0u);

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 
 #include "core/arena.h"
 #include "geometry/interaction.h"
@@ -26,13 +25,7 @@ SurfaceInteraction hit(const Scene& scene, Vec3 o, Vec3 d) {
 // A 2 x 1 single-channel PFM holding 0 and 1: bilinear between the texel centres at s = 1/4 and
 // 3/4, the texture rises by 2 per unit of s there.
 std::string ramp_pfm(const test::TempDir& dir) {
-  std::string bytes = "Pf\n2 1\n-1.0\n";
-  for (float v : {0.f, 1.f}) {
-    char b[4];
-    std::memcpy(b, &v, 4);
-    bytes.append(b, 4);
-  }
-  return dir.write("ramp.pfm", bytes);
+  return test::write_row_pfm(dir, "ramp.pfm", {0, 1});
 }
 
 // A quad over x in [0, 2], y in [0, 1] with uv = (x / 2, y): dp/du = (2, 0, 0), dp/dv = (0, 1, 0).
@@ -44,12 +37,9 @@ TEST(BumpMapping, ShadingNormalFollowsTheDisplacementsSlope) {
   test::TempDir dir;
   const std::string texture = "Texture \"ramp\" \"float\" \"imagemap\" \"string filename\" \"" +
                               ramp_pfm(dir) + "\" \"float scale\" 0.5\n";
-  test::captured_warnings().clear();
-  auto scene = load_pbrt(
-      dir.write("bump.pbrt",
-                with_camera(texture + "Material \"diffuse\" \"texture displacement\" \"ramp\"\n" +
-                            kQuad)),
-      test::capture_warning);
+  auto scene = test::load_file_text(
+      dir, "bump.pbrt",
+      with_camera(texture + "Material \"diffuse\" \"texture displacement\" \"ramp\"\n" + kQuad));
   EXPECT_TRUE(test::captured_warnings().empty());
   const SurfaceInteraction si = hit(*scene, {1, 0.5f, 1}, {0, 0, -1});
   EXPECT_NEAR(si.dpdu.x, 2, 1e-4f);

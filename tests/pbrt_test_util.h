@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <vector>
@@ -76,5 +78,24 @@ class TempDir {
   }
   std::filesystem::path path_;
 };
+
+// Writes a single-row, single-channel PFM of these values (little-endian) into dir; its path.
+inline std::string write_row_pfm(const TempDir& dir, const std::string& name,
+                                 std::initializer_list<float> values) {
+  std::string bytes = "Pf\n" + std::to_string(values.size()) + " 1\n-1.0\n";
+  for (float v : values) {
+    char b[4];
+    std::memcpy(b, &v, 4);
+    bytes.append(b, 4);
+  }
+  return dir.write(name, bytes);
+}
+
+// Loads `text` as the file `name` in dir (so it can refer to files there); warnings captured.
+inline std::unique_ptr<Scene> load_file_text(const TempDir& dir, const std::string& name,
+                                             const std::string& text) {
+  captured_warnings().clear();
+  return load_pbrt(dir.write(name, text), capture_warning);
+}
 
 }  // namespace caustica::test

@@ -89,7 +89,8 @@ std::optional<DirectLightSample> sample_direct_light(const Scene& scene,
 // Follows `ray` to the next vertex that scatters: through interfaces (no material, or a material
 // with no BSDF there) it goes straight on. Each segment's transmittance through absorbing media
 // (geometry/medium.h) is multiplied into beta before the surface it reaches is seen; `start` is
-// the segment's first end (the camera's, {}, or the previous vertex's medium_toward(ray.d)).
+// the segment's first end (the camera's, {}, or the previous vertex's medium_toward(ray.d)), and
+// ray.d is a unit vector, so that si->t is the segment's length.
 // on_emission(hit) is called for every surface reached (hit != nullptr) and, with nullptr, when
 // the ray escapes; then it returns false. On true, si and bsdf describe the vertex (bsdf
 // allocated in arena).
@@ -104,7 +105,7 @@ bool next_scattering_vertex(const Scene& scene, Ray& ray, SegmentEnd start, Rgb&
       on_emission(nullptr);
       return false;
     }
-    if (media) beta *= scene.transmittance(start, si->medium_toward(-ray.d), si->t * length(ray.d));
+    if (media) beta *= scene.transmittance(start, si->medium_toward(-ray.d), si->t);
     on_emission(si);
     if (si->material) {
       *bsdf = si->material->bsdf(*si, arena);
@@ -115,12 +116,12 @@ bool next_scattering_vertex(const Scene& scene, Ray& ray, SegmentEnd start, Rgb&
   }
 }
 
-// With absorbing media: what of the light sample's radiance reaches si through them, 0 where its
-// shadow ray is blocked (Scene::shadow_transmittance, geometry/medium.h).
-inline Rgb light_sample_transmittance(const Scene& scene, const SurfaceInteraction& si,
-                                      const DirectLightSample& d) {
-  return scene.shadow_transmittance(d.shadow, si.medium_toward(d.ls.wi),
-                                    d.light->medium_toward(d.ls.n_light, -d.ls.wi));
+// What of the light sample's radiance reaches si: 0 where its shadow ray is blocked, else the
+// transmittance of any absorbing media on the way (Scene::visibility, geometry/medium.h).
+inline Rgb light_sample_visibility(const Scene& scene, const SurfaceInteraction& si,
+                                   const DirectLightSample& d) {
+  return scene.visibility(d.shadow, si.medium_toward(d.ls.wi),
+                          d.light->medium_toward(d.ls.n_light, -d.ls.wi));
 }
 
 // What an unoccluded next event sample saw, for integrators that learn from it (path guiding):
@@ -150,10 +151,8 @@ Rgb direct_light_mis(const Scene& scene, const SurfaceInteraction& si, const Bsd
   if (bsdf.is_delta() || scene.light_sampler().empty()) return Rgb(0.f);
   const auto d = sample_direct_light(scene, si, bsdf, u_light, u);
   if (!d) return Rgb(0.f);
-  Rgb tr(1.f);
-  if (scene.traces_transmittance() ? (tr = light_sample_transmittance(scene, si, *d)).is_black()
-                                   : scene.occluded(d->shadow))
-    return Rgb(0.f);
+  const Rgb tr = light_sample_visibility(scene, si, *d);
+  if (tr.is_black()) return Rgb(0.f);
   const float light_pdf = probability * (d->pmf * d->ls.pdf_w);
   const float w = d->light->is_delta() ? 1.f : mis(light_pdf, sampling_pdf(d->ls.wi));
   if (seen) *seen = {d->ls.wi, d->ls.radiance * tr, d->f, light_pdf, w, d->light->is_delta()};

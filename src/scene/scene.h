@@ -86,6 +86,12 @@ class Scene {
   // piece. Integrators call it only where traces_transmittance(); else occluded() is the whole
   // answer.
   Rgb shadow_transmittance(Ray ray, SegmentEnd start, SegmentEnd end) const;
+  // What of the light along a shadow ray arrives: shadow_transmittance where the scene has media
+  // or interfaces, else 0 or 1 by occluded(). Every shadow ray of the integrators asks this.
+  Rgb visibility(const Ray& ray, SegmentEnd start, SegmentEnd end) const {
+    if (traces_transmittance()) return shadow_transmittance(ray, start, end);
+    return Rgb(occluded(ray) ? 0.f : 1.f);
+  }
   static constexpr int kMaxInterfaceCrossings = 64;
 
   const Camera& camera() const { return camera_; }

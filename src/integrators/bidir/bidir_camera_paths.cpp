@@ -270,10 +270,8 @@ void BidirIntegrator::next_event(const Scene& scene, const MisRules& rules, cons
   if (q < 1 && rng.next_float() >= q) return;
   // The shadow ray before the MIS terms: an occluded light costs no densities (a coated
   // BSDF's are random walks). The same contributions are made.
-  Rgb tr(1.f);  // through interfaces and absorbing media
-  const bool occluded = scene.traces_transmittance()
-                            ? (tr = light_sample_transmittance(scene, v.si, *d)).is_black()
-                            : scene.occluded(d->shadow);
+  const Rgb tr = light_sample_visibility(scene, v.si, *d);  // through media too
+  const bool occluded = tr.is_black();
   if (v.probabilities && guiding_.counts_techniques())
     guiding_.count_technique(GuidingField::kNextEvent, v.probabilities.leaf_toward(d->ls.wi),
                              !occluded);
@@ -365,13 +363,9 @@ void BidirIntegrator::connect_to_light_path(const Scene& scene, const MisRules& 
     if (f_light.is_black()) continue;
     ++acc.work.connections;
     // The shadow ray before the MIS terms, as for next event estimation.
-    Rgb tr(1.f);  // through interfaces and absorbing media
-    const bool occluded =
-        scene.traces_transmittance()
-            ? (tr = scene.shadow_transmittance(spawn_ray_between(si, light_si),
-                                               si.medium_toward(dir), light_si.medium_toward(-dir)))
-                  .is_black()
-            : scene.occluded(spawn_ray_between(si, light_si));
+    const Rgb tr = scene.visibility(spawn_ray_between(si, light_si), si.medium_toward(dir),
+                                    light_si.medium_toward(-dir));  // through media too
+    const bool occluded = tr.is_black();
     if (probabilities && guiding_.counts_techniques())
       guiding_.count_technique(GuidingField::kConnection, probabilities.leaf_toward(-dir),
                                !occluded);

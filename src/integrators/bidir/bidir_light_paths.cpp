@@ -340,14 +340,9 @@ void BidirIntegrator::connect_emission_to_camera(const Scene& scene, const Itera
   // The shadow ray before the splats and their MIS terms (up to 16 pixels under a wide filter).
   const Vec3 o =
       le.p + face_forward(le.n, cs->wi) * (1e-4f * std::max(1.f, max_component(abs(le.p))));
-  const Ray shadow{o, cs->p_lens - o, 1.f - 1e-4f};
-  Rgb seen = radiance;
-  if (scene.traces_transmittance()) {  // through interfaces and absorbing media
-    seen *= scene.shadow_transmittance(shadow, light.medium_toward(le.n, cs->wi), {});
-    if (seen.is_black()) return;
-  } else if (scene.occluded(shadow)) {
-    return;
-  }
+  const Rgb seen = radiance * scene.visibility({o, cs->p_lens - o, 1.f - 1e-4f},
+                                               light.medium_toward(le.n, cs->wi), {});
+  if (seen.is_black()) return;
   splat_lens_connection(
       camera, it, cs->raster, TechniqueImages::key(false, 1, 1),
       [&](float w) { return seen * (scale * w); },
@@ -383,12 +378,8 @@ Rgb BidirIntegrator::connect_to_camera(const Scene& scene, const Iteration& it,
       cs->importance * float(camera.pixel_count()) / (cs->pdf_w * float(it.plan.light_paths));
   // The shadow ray before the lens geometry's densities (a coated BSDF's reverse density is a
   // random walk) and the splats' MIS terms: the same splats are made.
-  Rgb tr(1.f);  // through interfaces and absorbing media
-  const bool occluded = scene.traces_transmittance()
-                            ? (tr = scene.shadow_transmittance(si.spawn_ray_to(cs->p_lens),
-                                                               si.medium_toward(cs->wi), {}))
-                                  .is_black()
-                            : scene.occluded(si.spawn_ray_to(cs->p_lens));
+  const Rgb tr = scene.visibility(si.spawn_ray_to(cs->p_lens), si.medium_toward(cs->wi), {});
+  const bool occluded = tr.is_black();  // through media too
   if (probabilities && guiding_.counts_techniques())
     guiding_.count_technique(GuidingField::kLensConnection, probabilities.leaf_toward(cs->wi),
                              !occluded);
